@@ -1,0 +1,352 @@
+"""Scene model: everything a render needs, as plain data.
+
+A :class:`SceneDescription` is what the Blender add-on exports and what the
+renderer consumes.  It holds numpy arrays and small dataclasses only, so it can
+be saved to one ``.npz`` file and rendered again without Blender
+(``SceneDescription.load(path)``).
+
+Conventions (the same as Blender and Cycles):
+
+* World space is Blender's: right-handed, +Z up, metres (the exporter applies
+  the scene unit scale).
+* Colours are linear, in the scene's working colour space.
+* Light colours are already multiplied by their strength (``color * energy *
+  2**exposure``, times the temperature colour): ``Light.strength`` is in watts
+  for point, spot and area lights and in W/m^2 for sun lights.
+* Emission of materials is radiance ``color * strength`` (no factor pi).
+* Images are stored top row first, as in EXR files.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "SceneError", "Geometry", "Material", "Light", "Camera", "World", "Film",
+    "Integrator", "SceneDescription",
+]
+
+LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
+
+
+class SceneError(ValueError):
+    """The scene description is invalid; the message says what and where."""
+
+
+@dataclass
+class Geometry:
+    """All triangles of the scene in world space.
+
+    vertices        (V, 3) float32  vertex positions
+    triangles       (T, 3) int32    vertex indices of each triangle
+    normals         (T, 3, 3) float32  shading normal at each corner (unit length)
+    uvs             (T, 3, 2) float32  UV at each corner (zeros if the mesh has none)
+    material_index  (T,) int32      index into ``SceneDescription.materials``
+    object_index    (T,) int32      index into ``object_names`` (for messages)
+    """
+
+    vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int32))
+    normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
+    uvs: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 2), np.float32))
+    material_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
+    object_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
+    object_names: list = field(default_factory=list)
+
+    @property
+    def num_triangles(self) -> int:
+        return int(self.triangles.shape[0])
+
+    @staticmethod
+    def from_triangles(positions, material_index=None, normals=None, uvs=None,
+                       object_index=None, object_names=None) -> "Geometry":
+        """Build from a (T, 3, 3) array of corner positions (flat shading by default)."""
+        p = np.asarray(positions, np.float64).reshape(-1, 3, 3)
+        t = p.shape[0]
+        if normals is None:
+            n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+            ln = np.linalg.norm(n, axis=1, keepdims=True)
+            n = np.where(ln > 0, n / np.where(ln > 0, ln, 1), [0.0, 0.0, 1.0])
+            normals = np.repeat(n[:, None, :], 3, axis=1)
+        return Geometry(
+            vertices=p.reshape(-1, 3).astype(np.float32),
+            triangles=np.arange(3 * t, dtype=np.int32).reshape(-1, 3),
+            normals=np.asarray(normals, np.float32).reshape(t, 3, 3),
+            uvs=(np.zeros((t, 3, 2), np.float32) if uvs is None
+                 else np.asarray(uvs, np.float32).reshape(t, 3, 2)),
+            material_index=(np.zeros(t, np.int32) if material_index is None
+                            else np.asarray(material_index, np.int32).reshape(t)),
+            object_index=(np.zeros(t, np.int32) if object_index is None
+                          else np.asarray(object_index, np.int32).reshape(t)),
+            object_names=list(object_names or ["object"]),
+        )
+
+    @staticmethod
+    def concatenate(parts) -> "Geometry":
+        """Join several geometries (object indices and names are merged)."""
+        parts = [g for g in parts if g.num_triangles]
+        if not parts:
+            return Geometry()
+        verts, tris, names, objs = [], [], [], []
+        v_off = 0
+        for g in parts:
+            verts.append(g.vertices)
+            tris.append(g.triangles + v_off)
+            objs.append(g.object_index + len(names))
+            names.extend(g.object_names)
+            v_off += g.vertices.shape[0]
+        return Geometry(
+            vertices=np.concatenate(verts), triangles=np.concatenate(tris),
+            normals=np.concatenate([g.normals for g in parts]),
+            uvs=np.concatenate([g.uvs for g in parts]),
+            material_index=np.concatenate([g.material_index for g in parts]),
+            object_index=np.concatenate(objs), object_names=names)
+
+
+@dataclass
+class Material:
+    """A surface shader reduced to the lobes the renderer knows.
+
+    ``base_color`` is the diffuse reflectance (Lambert).  ``emission`` is the
+    emitted radiance (colour x strength), emitted on both sides like Cycles'
+    mesh lights.  Glossy and transmissive lobes will be added as new fields
+    with defaults that leave existing materials unchanged.
+    """
+
+    name: str = "default"
+    base_color: tuple = (0.8, 0.8, 0.8)
+    emission: tuple = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class Light:
+    """A Blender lamp, in Cycles' units (see module docstring).
+
+    ``matrix_world`` is the object's 4x4 world matrix; lamps shine along local
+    -Z.  Area-light extents are multiplied by the object scale, point radii are
+    not (as in Cycles).
+    """
+
+    type: str = "POINT"
+    matrix_world: np.ndarray = field(default_factory=lambda: np.eye(4))
+    strength: tuple = (10.0, 10.0, 10.0)
+    radius: float = 0.0              # point/spot: shadow_soft_size
+    soft_falloff: bool = True        # point/spot: use_soft_falloff
+    spot_size: float = np.pi / 4     # full cone angle, radians
+    spot_blend: float = 0.15
+    angle: float = 0.0               # sun: full angular diameter, radians
+    shape: str = "SQUARE"            # area
+    size_x: float = 1.0              # area: 'size' for SQUARE and DISK
+    size_y: float = 1.0
+    spread: float = np.pi            # area
+    normalize: bool = True           # divide by the emitter area
+    cast_shadow: bool = True
+    use_mis: bool = True             # False: BSDF rays do not see the lamp
+    visible_camera: bool = False     # Blender 5.0 default for lamps
+    visible_diffuse: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
+    max_bounces: int = 1024
+    name: str = "Light"
+
+
+@dataclass
+class Camera:
+    """Blender camera data plus its world matrix (looks along local -Z, +Y up)."""
+
+    matrix_world: np.ndarray = field(default_factory=lambda: np.eye(4))
+    type: str = "PERSP"              # 'PERSP' or 'ORTHO'
+    lens: float = 50.0               # focal length, mm
+    sensor_width: float = 36.0       # mm
+    sensor_height: float = 24.0      # mm
+    sensor_fit: str = "AUTO"         # 'AUTO', 'HORIZONTAL', 'VERTICAL'
+    shift_x: float = 0.0
+    shift_y: float = 0.0
+    ortho_scale: float = 6.0
+    clip_start: float = 0.1
+    clip_end: float = 1000.0
+
+
+@dataclass
+class World:
+    """Constant background: radiance = colour x strength."""
+
+    color: tuple = (0.0509, 0.0509, 0.0509)
+    visible_camera: bool = True
+
+
+@dataclass
+class Film:
+    """Output raster.
+
+    ``width``/``height`` are the full frame in pixels (resolution percentage
+    already applied).  ``region`` is the rendered window ``(x0, y0, x1, y1)`` in
+    pixels, top-left origin, x1/y1 exclusive; ``None`` means the whole frame.
+    """
+
+    width: int = 128
+    height: int = 128
+    pixel_aspect_x: float = 1.0
+    pixel_aspect_y: float = 1.0
+    region: tuple | None = None
+    filter_type: str = "BLACKMAN_HARRIS"
+    filter_width: float = 1.5
+    transparent: bool = False
+    exposure: float = 1.0
+
+    @property
+    def window(self) -> tuple:
+        return tuple(self.region) if self.region is not None else (0, 0, self.width, self.height)
+
+
+@dataclass
+class Integrator:
+    """Sampling and path settings, named as Cycles names them."""
+
+    samples: int = 64
+    seed: int = 0
+    max_bounces: int = 12
+    diffuse_bounces: int = 4
+    glossy_bounces: int = 4
+    transmission_bounces: int = 12
+    transparent_max_bounces: int = 8
+    min_light_bounces: int = 0
+    clamp_direct: float = 0.0        # 0 = off
+    clamp_indirect: float = 0.0      # 0 = off
+    time_limit: float = 0.0          # seconds, 0 = none
+
+
+@dataclass
+class SceneDescription:
+    geometry: Geometry = field(default_factory=Geometry)
+    materials: list = field(default_factory=lambda: [Material()])
+    lights: list = field(default_factory=list)
+    camera: Camera = field(default_factory=Camera)
+    world: World = field(default_factory=World)
+    film: Film = field(default_factory=Film)
+    integrator: Integrator = field(default_factory=Integrator)
+    warnings: list = field(default_factory=list)
+
+    # -- validation --------------------------------------------------------
+    def validate(self) -> "SceneDescription":
+        """Raise :class:`SceneError` with a one-line message if anything is unusable."""
+        g = self.geometry
+        t = g.num_triangles
+        if g.vertices.ndim != 2 or g.vertices.shape[1] != 3:
+            raise SceneError(f"geometry.vertices must be (V, 3), got {g.vertices.shape}")
+        for name, arr, shape in (("triangles", g.triangles, (t, 3)),
+                                 ("normals", g.normals, (t, 3, 3)),
+                                 ("uvs", g.uvs, (t, 3, 2)),
+                                 ("material_index", g.material_index, (t,)),
+                                 ("object_index", g.object_index, (t,))):
+            if arr.shape != shape:
+                raise SceneError(f"geometry.{name} has shape {arr.shape}, expected {shape}")
+        if t and (g.triangles.min() < 0 or g.triangles.max() >= g.vertices.shape[0]):
+            raise SceneError("geometry.triangles refers to vertices that do not exist")
+        if not np.all(np.isfinite(g.vertices)):
+            raise SceneError("geometry.vertices contains NaN or infinite coordinates")
+        if t and (g.material_index.min() < 0 or g.material_index.max() >= len(self.materials)):
+            raise SceneError("geometry.material_index refers to a material that does not exist")
+        if not self.materials:
+            raise SceneError("the scene needs at least one material")
+        for m in self.materials:
+            for attr in ("base_color", "emission"):
+                v = np.asarray(getattr(m, attr), float)
+                if v.shape != (3,) or not np.all(np.isfinite(v)) or np.any(v < 0):
+                    raise SceneError(f"material '{m.name}': {attr} must be 3 finite non-negative values")
+        for li in self.lights:
+            if li.type not in LIGHT_TYPES:
+                raise SceneError(f"light '{li.name}': unknown type {li.type!r}")
+            if li.type == "AREA" and li.shape not in AREA_SHAPES:
+                raise SceneError(f"light '{li.name}': unknown area shape {li.shape!r}")
+            m = np.asarray(li.matrix_world, float)
+            if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+                raise SceneError(f"light '{li.name}': matrix_world must be a finite 4x4 matrix")
+            s = np.asarray(li.strength, float)
+            if s.shape != (3,) or not np.all(np.isfinite(s)):
+                raise SceneError(f"light '{li.name}': strength must be 3 finite values")
+        f = self.film
+        if f.width < 1 or f.height < 1:
+            raise SceneError(f"film resolution must be positive, got {f.width}x{f.height}")
+        x0, y0, x1, y1 = f.window
+        if not (0 <= x0 < x1 <= f.width and 0 <= y0 < y1 <= f.height):
+            raise SceneError(f"film region {f.window} is empty or outside the {f.width}x{f.height} frame")
+        if f.filter_type not in FILTER_TYPES:
+            raise SceneError(f"unknown pixel filter {f.filter_type!r}")
+        c = self.camera
+        if c.type not in ("PERSP", "ORTHO"):
+            raise SceneError(f"camera type {c.type!r} is not supported (PERSP, ORTHO)")
+        if c.type == "PERSP" and c.lens <= 0:
+            raise SceneError("camera focal length must be positive")
+        i = self.integrator
+        if i.samples < 1:
+            raise SceneError(f"samples must be at least 1, got {i.samples}")
+        for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
+            if getattr(i, attr) < 0:
+                raise SceneError(f"integrator.{attr} must not be negative")
+        return self
+
+    # -- persistence -------------------------------------------------------
+    def save(self, path) -> None:
+        """Write the whole description to one ``.npz`` file."""
+        g = self.geometry
+        meta = {
+            "object_names": g.object_names,
+            "materials": [dataclasses.asdict(m) for m in self.materials],
+            "lights": [_light_meta(li) for li in self.lights],
+            "camera": _plain(dataclasses.asdict(self.camera)),
+            "world": dataclasses.asdict(self.world),
+            "film": dataclasses.asdict(self.film),
+            "integrator": dataclasses.asdict(self.integrator),
+            "warnings": list(self.warnings),
+        }
+        np.savez_compressed(
+            path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
+            uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
+            meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
+
+    @staticmethod
+    def load(path) -> "SceneDescription":
+        path = Path(path)
+        try:
+            z = np.load(path, allow_pickle=False)
+            meta = json.loads(bytes(z["meta"]).decode())
+        except (OSError, KeyError, ValueError) as exc:
+            raise SceneError(f"{path}: not a saved mcengine scene ({exc})") from None
+        geom = Geometry(vertices=z["vertices"], triangles=z["triangles"], normals=z["normals"],
+                        uvs=z["uvs"], material_index=z["material_index"],
+                        object_index=z["object_index"], object_names=meta["object_names"])
+        lights = []
+        for d in meta["lights"]:
+            d["matrix_world"] = np.array(d["matrix_world"], float)
+            lights.append(Light(**{k: (tuple(v) if isinstance(v, list) and k != "matrix_world" else v)
+                                   for k, v in d.items()}))
+        cam = dict(meta["camera"])
+        cam["matrix_world"] = np.array(cam["matrix_world"], float)
+        film = dict(meta["film"])
+        if film.get("region") is not None:
+            film["region"] = tuple(film["region"])
+        return SceneDescription(
+            geometry=geom,
+            materials=[Material(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in d.items()})
+                       for d in meta["materials"]],
+            lights=lights, camera=Camera(**cam),
+            world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
+            film=Film(**film), integrator=Integrator(**meta["integrator"]),
+            warnings=meta.get("warnings", []))
+
+
+def _plain(d: dict) -> dict:
+    return {k: (np.asarray(v).tolist() if isinstance(v, np.ndarray) else v) for k, v in d.items()}
+
+
+def _light_meta(li: Light) -> dict:
+    d = _plain(dataclasses.asdict(li))
+    d["strength"] = [float(x) for x in d["strength"]]
+    return {k: (float(v) if isinstance(v, np.floating) else v) for k, v in d.items()}

@@ -1,0 +1,129 @@
+"""Camera: from raster positions to world-space rays, with Blender's conventions.
+
+The camera looks along its local -Z with +Y up.  The view plane at distance 1
+(perspective) or the film rectangle (orthographic) is fitted as Cycles fits it
+(intern/cycles/blender/camera.cpp):
+
+* ``sensor_fit`` AUTO applies the sensor width to the larger image dimension
+  (pixel aspect included), HORIZONTAL always to the width, VERTICAL applies the
+  sensor height to the height;
+* the half-extent of the fitted dimension is ``sensor / (2 lens)`` at distance 1
+  (perspective) or ``ortho_scale / 2`` (orthographic);
+* ``shift_x`` and ``shift_y`` are fractions of the fitted dimension;
+* ``clip_start`` and ``clip_end`` are planes perpendicular to the view axis.
+
+Raster coordinates: x to the right, y downwards, (0, 0) the top-left corner of
+the full frame; pixel (i, j) covers [i, i+1) x [j, j+1).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+CAM_PERSP = 0
+CAM_ORTHO = 1
+
+# Layout of the packed camera parameter vector used by the kernels.
+C_TYPE = 0
+C_POS = 1            # 3: camera position
+C_RIGHT = 4          # 3: unit +X axis (world)
+C_UP = 7             # 3: unit +Y axis (world)
+C_FWD = 10           # 3: unit -Z axis (world), the view direction
+C_HALF_W = 13        # half width of the view plane at distance 1 (or film, ortho)
+C_HALF_H = 14
+C_SHIFT_X = 15       # view-plane centre offset, same units
+C_SHIFT_Y = 16
+C_CLIP_START = 17
+C_CLIP_END = 18
+C_WIDTH = 19         # full frame in pixels
+C_HEIGHT = 20
+CAMERA_PARAMS = 21
+
+
+def view_plane(cam, width: int, height: int, pixel_aspect=(1.0, 1.0)):
+    """Half-extents and centre offset of the view plane, as Cycles computes them.
+
+    Returns ``(half_w, half_h, shift_x, shift_y)`` in units of the plane at
+    distance 1 (perspective) or metres (orthographic).
+    """
+    xratio = width * pixel_aspect[0]
+    yratio = height * pixel_aspect[1]
+    if cam.sensor_fit == "AUTO":
+        horizontal = xratio >= yratio
+        sensor = cam.sensor_width
+    elif cam.sensor_fit == "HORIZONTAL":
+        horizontal = True
+        sensor = cam.sensor_width
+    elif cam.sensor_fit == "VERTICAL":
+        horizontal = False
+        sensor = cam.sensor_height
+    else:
+        raise ValueError(f"unknown sensor fit {cam.sensor_fit!r}")
+    if cam.type == "ORTHO":
+        half_fit = 0.5 * cam.ortho_scale
+    else:
+        half_fit = 0.5 * sensor / cam.lens
+    if horizontal:
+        half_w, half_h = half_fit, half_fit * yratio / xratio
+    else:
+        half_w, half_h = half_fit * xratio / yratio, half_fit
+    return half_w, half_h, 2.0 * half_fit * cam.shift_x, 2.0 * half_fit * cam.shift_y
+
+
+def pack_camera(cam, film) -> np.ndarray:
+    """Packed float64 parameter vector (layout ``C_*``) for the kernels."""
+    m = np.asarray(cam.matrix_world, np.float64)
+    # Cycles removes the object scale from the camera matrix.
+    right = m[:3, 0] / np.linalg.norm(m[:3, 0])
+    up = m[:3, 1] / np.linalg.norm(m[:3, 1])
+    fwd = -m[:3, 2] / np.linalg.norm(m[:3, 2])
+    half_w, half_h, sx, sy = view_plane(cam, film.width, film.height,
+                                        (film.pixel_aspect_x, film.pixel_aspect_y))
+    p = np.zeros(CAMERA_PARAMS)
+    p[C_TYPE] = CAM_ORTHO if cam.type == "ORTHO" else CAM_PERSP
+    p[C_POS:C_POS + 3] = m[:3, 3]
+    p[C_RIGHT:C_RIGHT + 3] = right
+    p[C_UP:C_UP + 3] = up
+    p[C_FWD:C_FWD + 3] = fwd
+    p[C_HALF_W], p[C_HALF_H] = half_w, half_h
+    p[C_SHIFT_X], p[C_SHIFT_Y] = sx, sy
+    p[C_CLIP_START], p[C_CLIP_END] = cam.clip_start, cam.clip_end
+    p[C_WIDTH], p[C_HEIGHT] = film.width, film.height
+    return p
+
+
+@njit(cache=True)
+def camera_ray(cam, rx, ry):
+    """World-space ray through raster position (rx, ry).
+
+    Returns ``(ox, oy, oz, dx, dy, dz, tmax)`` with a unit direction; the
+    origin lies on the near clip plane and ``tmax`` reaches the far plane.
+    """
+    x = cam[C_SHIFT_X] + (2.0 * rx / cam[C_WIDTH] - 1.0) * cam[C_HALF_W]
+    y = cam[C_SHIFT_Y] + (1.0 - 2.0 * ry / cam[C_HEIGHT]) * cam[C_HALF_H]
+    if cam[C_TYPE] == CAM_ORTHO:
+        ox = cam[C_POS] + x * cam[C_RIGHT] + y * cam[C_UP] + cam[C_CLIP_START] * cam[C_FWD]
+        oy = cam[C_POS + 1] + x * cam[C_RIGHT + 1] + y * cam[C_UP + 1] + cam[C_CLIP_START] * cam[C_FWD + 1]
+        oz = cam[C_POS + 2] + x * cam[C_RIGHT + 2] + y * cam[C_UP + 2] + cam[C_CLIP_START] * cam[C_FWD + 2]
+        return ox, oy, oz, cam[C_FWD], cam[C_FWD + 1], cam[C_FWD + 2], cam[C_CLIP_END] - cam[C_CLIP_START]
+    dx = x * cam[C_RIGHT] + y * cam[C_UP] + cam[C_FWD]
+    dy = x * cam[C_RIGHT + 1] + y * cam[C_UP + 1] + cam[C_FWD + 1]
+    dz = x * cam[C_RIGHT + 2] + y * cam[C_UP + 2] + cam[C_FWD + 2]
+    inv_len = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    dx *= inv_len
+    dy *= inv_len
+    dz *= inv_len
+    # The direction's component along the view axis is inv_len: the clip planes
+    # are at depth clip_start and clip_end, i.e. at ray distances depth/inv_len.
+    t0 = cam[C_CLIP_START] / inv_len
+    return (cam[C_POS] + t0 * dx, cam[C_POS + 1] + t0 * dy, cam[C_POS + 2] + t0 * dz,
+            dx, dy, dz, (cam[C_CLIP_END] - cam[C_CLIP_START]) / inv_len)
+
+
+def camera_rays(scene_camera, film, rx, ry):
+    """Vectorised helper (tests, tools): rays for arrays of raster positions."""
+    p = pack_camera(scene_camera, film)
+    out = np.array([camera_ray(p, float(a), float(b)) for a, b in zip(np.ravel(rx), np.ravel(ry))])
+    return out[:, :3], out[:, 3:6], out[:, 6]

@@ -1,0 +1,648 @@
+"""Wavefront path tracing: camera rays, surface shading, next-event estimation.
+
+One *chunk* is a batch of path samples (a range of film pixels times a few
+samples each).  A worker traces its chunk bounce by bounce:
+
+1. ``generate_camera_rays``      fill the path state and the ray buffers;
+2. ``Accel.closest``             one Embree call for all live rays;
+3. ``shade``                     emission (lamps, world, emissive triangles,
+                                 with MIS), Russian roulette, next-event
+                                 estimation (one light sample, a shadow ray),
+                                 BSDF sampling of the next direction;
+4. ``Accel.occluded``            one Embree call for all shadow rays;
+5. ``finish_bounce``             add unoccluded light, write finished paths to
+                                 the film, compact the live paths to the front.
+
+The algorithm follows Cycles (intern/cycles/kernel/integrator/) where that
+decides the expected value: bounce limits (a vertex scatters while no bounce
+counter exceeds its limit; the next vertex only collects emission), lamps
+that rays pass through, per-light visibility and MIS switches, light
+``max_bounces`` gating NEE only, clamping per contribution, Russian roulette
+from the third vertex on, film transparency.  See notes in each step.
+
+Stages are scalar loops compiled by numba (``nogil``), so two workers in two
+Python threads keep both cores busy; Embree releases the GIL as well.
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from .bsdf import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
+                   M_EMISSION, M_EMISSIVE, bsdf_eval, bsdf_has_lobes, bsdf_sample)
+from .camera import camera_ray
+from .intersect import (SHADOW_SHORTEN, T_INFINITE, intersect_triangle, offset_origin,
+                        offset_scale)
+from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW,
+                     LF_USE_MIS, LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY,
+                     LF_VIS_TRANSMISSION, LT_SUN, intersect_lamp, pick_light, sample_lamp,
+                     sample_triangle_point, sun_radiance)
+from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_FILTER_X, DIM_FILTER_Y,
+                       DIM_LIGHT_PICK, DIM_LIGHT_U, DIM_LIGHT_V, DIM_ROULETTE, bounce_dim,
+                       filter_offset, orthonormal_basis, path_key, power_heuristic, rand)
+
+# -- path state ----------------------------------------------------------------------
+PathState = namedtuple("PathState", [
+    "key",           # (B,) uint64   RNG key of the path sample
+    "pixel",         # (B,) int32    film pixel (index into the film region)
+    "ray_o",         # (B, 3) f64    ray origin
+    "ray_d",         # (B, 3) f64    unit ray direction
+    "ray_tmax",      # (B,) f64      ray length (far clip for camera rays)
+    "beta",          # (B, 3) f64    path throughput
+    "radiance",      # (B, 3) f64    radiance collected so far
+    "transparency",  # (B,) f64      1 if the camera ray escaped to a transparent film
+    "bounce",        # (B,) int32    scattering events so far (= index of the next vertex)
+    "diffuse",       # (B,) int32    diffuse scattering events so far
+    "glossy",        # (B,) int32
+    "transmission",  # (B,) int32
+    "transparent",   # (B,) int32    transparent passes (lamps count as one)
+    "flags",         # (B,) int32    PF_* bits
+    "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
+    "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
+    "alive",         # (B,) uint8    still tracing after this bounce
+    "o32",           # (B, 3) f32    Embree input: origins
+    "d32",           # (B, 3) f32    Embree input: directions
+    "t32",           # (B,) f32      Embree input: tfar
+])
+
+ShadowQueue = namedtuple("ShadowQueue", [
+    "o32", "d32", "t32",   # Embree input
+    "contrib",             # (B, 3) f64  radiance to add if unoccluded
+    "path",                # (B,) int32  path the contribution belongs to
+])
+
+SceneData = namedtuple("SceneData", [
+    "verts",         # (V, 3) f64
+    "tris",          # (T, 3) int32
+    "normals",       # (T, 3, 3) f32  shading normals at the corners
+    "mat_index",     # (T,) int32
+    "materials",     # (M, MATERIAL_STRIDE) f64
+    "lamps",         # (NL, LIGHT_STRIDE) f64
+    "light_cdf",     # (NL + NE + 1,) f64  NEE light distribution
+    "emit_tri",      # (NE,) int32  emissive triangle ids
+    "emit_pmf",      # (NE,) f64    their NEE probabilities
+    "tri_light",     # (T,) int32   index into emit_tri, or -1
+    "tri_area",      # (T,) f64
+    "world",         # (3,) f64     background radiance
+    "camera",        # (CAMERA_PARAMS,) f64
+    "filter_table",  # (FILTER_TABLE_SIZE,) f64
+])
+
+# Path flags.
+PF_CAMERA = 1            # no scattering yet: the ray is a camera ray
+PF_MIS_SKIP = 2          # emission found by this ray gets MIS weight 1
+PF_TERMINATE = 4         # a bounce limit was reached: the next hit only collects emission
+PF_TRANSPARENT_BG = 8    # camera ray on a transparent film: the background gives alpha 0
+PF_DIFFUSE = 16          # label of the BSDF sample that made the ray
+PF_GLOSSY = 32
+PF_TRANSMIT = 64
+PF_REFLECT = 128
+
+# Integer settings (cfg array).
+CFG_MAX_BOUNCE = 0
+CFG_MAX_DIFFUSE = 1
+CFG_MAX_GLOSSY = 2
+CFG_MAX_TRANSMISSION = 3
+CFG_MAX_TRANSPARENT = 4
+CFG_MIN_LIGHT_BOUNCES = 5
+CFG_SEED = 6
+CFG_FILM_TRANSPARENT = 7
+CFG_WORLD_CAMERA = 8      # world visible to camera rays
+CFG_LAMPS_HIT = 9         # some lamp can be hit by rays (Cycles' use_light_mis)
+CFG_REGION_X = 10         # film region origin and width in the full frame
+CFG_REGION_Y = 11
+CFG_REGION_W = 12
+CFG_FULL_W = 13
+CFG_LIGHTS = 14           # NEE has something to sample
+CFG_WORLD = 15            # the world is not black
+CFG_SIZE = 16
+# Float settings (fcfg array).
+FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
+FCFG_CLAMP_INDIRECT = 1
+FCFG_SIZE = 2
+
+# Statistics counters (stats array, per worker).
+ST_CAMERA_RAYS = 0
+ST_BOUNCE_RAYS = 1
+ST_SHADOW_RAYS = 2
+ST_SELF_HITS = 3          # rays that re-hit their origin triangle and were re-traced
+ST_NONFINITE = 4          # contributions dropped because they were NaN or infinite
+ST_SIZE = 5
+
+
+def alloc_path_state(n: int) -> PathState:
+    """Buffers for n paths, allocated once per worker and reused."""
+    return PathState(
+        key=np.zeros(n, np.uint64), pixel=np.zeros(n, np.int32),
+        ray_o=np.zeros((n, 3)), ray_d=np.zeros((n, 3)), ray_tmax=np.zeros(n),
+        beta=np.zeros((n, 3)), radiance=np.zeros((n, 3)), transparency=np.zeros(n),
+        bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
+        glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
+        transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
+        mis_pdf=np.zeros(n), self_prim=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
+        o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
+        t32=np.zeros(n, np.float32))
+
+
+def alloc_shadow_queue(n: int) -> ShadowQueue:
+    return ShadowQueue(o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
+                       t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
+                       path=np.zeros(n, np.int32))
+
+
+# -- 1. camera rays ----------------------------------------------------------------------
+@njit(cache=True, nogil=True)
+def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
+    """Start ``spp`` paths for each film pixel in ``pixels``; returns the path count.
+
+    The sample index of a path is the pixel's count of finished samples
+    (``sample_base``) plus its rank here, so every sample of a pixel has its
+    own random numbers whatever the pass schedule.
+    """
+    n = 0
+    region_x, region_y, region_w = cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W]
+    transparent_bg = PF_TRANSPARENT_BG if cfg[CFG_FILM_TRANSPARENT] else 0
+    for pi in range(pixels.shape[0]):
+        pix = pixels[pi]
+        x = region_x + pix % region_w
+        y = region_y + pix // region_w
+        global_pixel = y * cfg[CFG_FULL_W] + x
+        for j in range(spp):
+            sample = sample_base[pix] + j
+            key = path_key(cfg[CFG_SEED], global_pixel, sample)
+            # Cycles takes the first sample of every pixel at the pixel centre.
+            if sample == 0:
+                fx, fy = 0.5, 0.5
+            else:
+                fx = filter_offset(sc.filter_table, rand(key, DIM_FILTER_X))
+                fy = filter_offset(sc.filter_table, rand(key, DIM_FILTER_Y))
+            ox, oy, oz, dx, dy, dz, tmax = camera_ray(sc.camera, x + fx, y + fy)
+            st.key[n] = key
+            st.pixel[n] = pix
+            st.ray_o[n, 0], st.ray_o[n, 1], st.ray_o[n, 2] = ox, oy, oz
+            st.ray_d[n, 0], st.ray_d[n, 1], st.ray_d[n, 2] = dx, dy, dz
+            st.ray_tmax[n] = tmax
+            st.beta[n, 0], st.beta[n, 1], st.beta[n, 2] = 1.0, 1.0, 1.0
+            st.radiance[n, 0], st.radiance[n, 1], st.radiance[n, 2] = 0.0, 0.0, 0.0
+            st.transparency[n] = 0.0
+            st.bounce[n] = 0
+            st.diffuse[n] = 0
+            st.glossy[n] = 0
+            st.transmission[n] = 0
+            st.transparent[n] = 0
+            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | transparent_bg
+            st.mis_pdf[n] = 0.0
+            st.self_prim[n] = -1
+            st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz
+            st.d32[n, 0], st.d32[n, 1], st.d32[n, 2] = dx, dy, dz
+            st.t32[n] = min(tmax, T_INFINITE)
+            n += 1
+    return n
+
+
+# -- helpers ---------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _clamp(r, g, b, limit, stats):
+    """Cycles' film_clamp_light: drop non-finite values, cap |r|+|g|+|b| at limit."""
+    if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
+        stats[ST_NONFINITE] += 1
+        return 0.0, 0.0, 0.0
+    s = abs(r) + abs(g) + abs(b)
+    if s > limit:
+        k = limit / s
+        return r * k, g * k, b * k
+    return r, g, b
+
+
+@njit(cache=True, inline="always")
+def _add(st, i, r, g, b, direct, fcfg, stats):
+    limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
+    r, g, b = _clamp(r, g, b, limit, stats)
+    st.radiance[i, 0] += r
+    st.radiance[i, 1] += g
+    st.radiance[i, 2] += b
+
+
+@njit(cache=True, inline="always")
+def _lamp_visible_to_ray(flags, lamp_flags):
+    """Cycles' is_light_shader_visible_to_path for a ray of the given path flags."""
+    if flags & PF_CAMERA:
+        return (lamp_flags & LF_VIS_CAMERA) != 0
+    if (lamp_flags & LF_USE_MIS) == 0:
+        return False
+    if (flags & PF_DIFFUSE) and not (lamp_flags & LF_VIS_DIFFUSE):
+        return False
+    if (flags & PF_GLOSSY) and (flags & PF_REFLECT) and not (lamp_flags & LF_VIS_GLOSSY):
+        return False
+    if (flags & PF_TRANSMIT) and not (lamp_flags & LF_VIS_TRANSMISSION):
+        return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _nee_exclude(lamp_flags):
+    """BSDF lobes a light must not illuminate (its ray-visibility switches)."""
+    ex = 0
+    if not (lamp_flags & LF_VIS_DIFFUSE):
+        ex |= LABEL_DIFFUSE
+    if not (lamp_flags & LF_VIS_GLOSSY):
+        ex |= LABEL_GLOSSY
+    if not (lamp_flags & LF_VIS_TRANSMISSION):
+        ex |= LABEL_TRANSMIT
+    return ex
+
+
+@njit(cache=True, inline="always")
+def _set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
+    st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2] = ox, oy, oz
+    st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2] = dx, dy, dz
+    st.ray_tmax[i] = tmax
+    st.o32[i, 0], st.o32[i, 1], st.o32[i, 2] = ox, oy, oz
+    st.d32[i, 0], st.d32[i, 1], st.d32[i, 2] = dx, dy, dz
+    st.t32[i] = min(tmax, T_INFINITE)
+
+
+# -- 3. shading ------------------------------------------------------------------------------
+@njit(cache=True, nogil=True)
+def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
+    """Shade the hits of the n live rays; returns the number of queued shadow rays."""
+    n_shadow = 0
+    n_lamps = sc.lamps.shape[0]
+    lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    for i in range(n):
+        flags = st.flags[i]
+        ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        p = prim[i]
+        st.alive[i] = 0
+
+        # Spurious re-hit of the triangle the ray left (possible only through
+        # rounding, triangles being flat): continue from just past it.
+        if p >= 0 and p == st.self_prim[i]:
+            stats[ST_SELF_HITS] += 1
+            v0, v1, v2 = sc.verts[sc.tris[p, 0]], sc.verts[sc.tris[p, 1]], sc.verts[sc.tris[p, 2]]
+            t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2)
+            if not math.isfinite(t) or t < 0.0:
+                t = 0.0
+            s = offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
+            _set_ray(st, i, ox + (t + s) * dx, oy + (t + s) * dy, oz + (t + s) * dz, dx, dy, dz,
+                     st.ray_tmax[i] - t - s)
+            st.alive[i] = 1
+            continue
+
+        t_hit = st.ray_tmax[i]
+        b1 = b2 = 0.0
+        if p >= 0:
+            v0, v1, v2 = sc.verts[sc.tris[p, 0]], sc.verts[sc.tris[p, 1]], sc.verts[sc.tris[p, 2]]
+            t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2)
+            t_hit = t if (math.isfinite(t) and t > 0.0) else 0.0
+        arrival_direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
+
+        # -- lamps along the ray (they do not block it) --------------------------------
+        if lamps_hit:
+            last_t = 0.0
+            while True:
+                # The nearest lamp beyond last_t (lamps are few; rays pass through them).
+                best_t = t_hit
+                best = -1
+                br = bg = bb = bpdf = 0.0
+                for li in range(n_lamps):
+                    lamp = sc.lamps[li]
+                    if not _lamp_visible_to_ray(flags, int(lamp[L_FLAGS])):
+                        continue
+                    tl, lr, lg, lb, lpdf = intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, best_t)
+                    if tl > last_t and tl < best_t:
+                        best_t, best = tl, li
+                        br, bg, bb, bpdf = lr, lg, lb, lpdf
+                if best < 0:
+                    break
+                w = 1.0
+                if not (flags & PF_MIS_SKIP):
+                    w = power_heuristic(st.mis_pdf[i], sc.lamps[best, L_PMF] * bpdf)
+                _add(st, i, st.beta[i, 0] * br * w, st.beta[i, 1] * bg * w, st.beta[i, 2] * bb * w,
+                     arrival_direct, fcfg, stats)
+                last_t = best_t
+                st.transparent[i] += 1
+                if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
+                    p = -2   # terminate after the lamp's light
+                    break
+            if p == -2:
+                continue
+
+        # -- escaped: world and suns ---------------------------------------------------
+        if p < 0:
+            if flags & PF_TRANSPARENT_BG:
+                st.transparency[i] = 1.0
+            elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
+                _add(st, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
+                     st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
+            for li in range(n_lamps):
+                lamp = sc.lamps[li]
+                if int(lamp[L_TYPE]) != LT_SUN or lamp[L_SUN_COS] >= 1.0:
+                    continue
+                lflags = int(lamp[L_FLAGS])
+                if not (lflags & LF_USE_MIS) or not _lamp_visible_to_ray(flags, lflags):
+                    continue
+                lr, lg, lb, lpdf = sun_radiance(lamp, dx, dy, dz)
+                if lpdf > 0.0:
+                    w = 1.0
+                    if not (flags & PF_MIS_SKIP):
+                        w = power_heuristic(st.mis_pdf[i], lamp[L_PMF] * lpdf)
+                    _add(st, i, st.beta[i, 0] * lr * w, st.beta[i, 1] * lg * w,
+                         st.beta[i, 2] * lb * w, arrival_direct, fcfg, stats)
+            continue
+
+        # -- surface hit ---------------------------------------------------------------
+        hx = v0[0] + b1 * (v1[0] - v0[0]) + b2 * (v2[0] - v0[0])
+        hy = v0[1] + b1 * (v1[1] - v0[1]) + b2 * (v2[1] - v0[1])
+        hz = v0[2] + b1 * (v1[2] - v0[2]) + b2 * (v2[2] - v0[2])
+        e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
+        e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+        ngx, ngy, ngz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+        ln = math.sqrt(ngx * ngx + ngy * ngy + ngz * ngz)
+        if ln == 0.0:
+            continue   # degenerate triangle: Embree should not report it; drop the path
+        ngx, ngy, ngz = ngx / ln, ngy / ln, ngz / ln
+        b0 = 1.0 - b1 - b2
+        nsx = b0 * sc.normals[p, 0, 0] + b1 * sc.normals[p, 1, 0] + b2 * sc.normals[p, 2, 0]
+        nsy = b0 * sc.normals[p, 0, 1] + b1 * sc.normals[p, 1, 1] + b2 * sc.normals[p, 2, 1]
+        nsz = b0 * sc.normals[p, 0, 2] + b1 * sc.normals[p, 1, 2] + b2 * sc.normals[p, 2, 2]
+        ln = math.sqrt(nsx * nsx + nsy * nsy + nsz * nsz)
+        if ln > 0.0 and math.isfinite(ln):
+            nsx, nsy, nsz = nsx / ln, nsy / ln, nsz / ln
+            if nsx * ngx + nsy * ngy + nsz * ngz < 0.0:
+                # Shading normal on the other side of the triangle than its
+                # winding: treat the winding as wrong (e.g. mirrored instances).
+                ngx, ngy, ngz = -ngx, -ngy, -ngz
+        else:
+            nsx, nsy, nsz = ngx, ngy, ngz
+        # All BSDFs are two-sided: face the normals towards the incoming ray.
+        cos_o_geo = -(dx * ngx + dy * ngy + dz * ngz)
+        if cos_o_geo < 0.0:
+            ngx, ngy, ngz = -ngx, -ngy, -ngz
+            nsx, nsy, nsz = -nsx, -nsy, -nsz
+            cos_o_geo = -cos_o_geo
+        mat = sc.materials[sc.mat_index[p]]
+
+        # Russian roulette (Cycles: from the third vertex on, with the
+        # throughput as it is; emission here is not affected by it).
+        q = 1.0
+        if st.bounce[i] > cfg[CFG_MIN_LIGHT_BOUNCES] + 1 and not (flags & PF_TERMINATE):
+            q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
+
+        # Emission (two-sided).
+        if mat[M_EMISSIVE] > 0.0:
+            w = 1.0
+            if not (flags & PF_MIS_SKIP):
+                j = sc.tri_light[p]
+                if j >= 0:
+                    light_pdf = sc.emit_pmf[j] * t_hit * t_hit / (sc.tri_area[p] * cos_o_geo)
+                    w = power_heuristic(st.mis_pdf[i], light_pdf)
+            _add(st, i, st.beta[i, 0] * mat[M_EMISSION] * w, st.beta[i, 1] * mat[M_EMISSION + 1] * w,
+                 st.beta[i, 2] * mat[M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
+
+        if (flags & PF_TERMINATE) or not bsdf_has_lobes(mat):
+            continue
+        bounce = st.bounce[i]
+        key = st.key[i]
+        if q < 1.0:
+            if rand(key, bounce_dim(bounce, DIM_ROULETTE)) >= q:
+                continue
+            st.beta[i, 0] /= q
+            st.beta[i, 1] /= q
+            st.beta[i, 2] /= q
+
+        # Local shading frame.
+        tx, ty, tz, bx, by, bz = orthonormal_basis(nsx, nsy, nsz)
+        wox = -(dx * tx + dy * ty + dz * tz)
+        woy = -(dx * bx + dy * by + dz * bz)
+        woz = -(dx * nsx + dy * nsy + dz * nsz)
+        nee_direct = bounce == 0
+
+        # -- next-event estimation -------------------------------------------------------
+        if cfg[CFG_LIGHTS]:
+            idx = pick_light(sc.light_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_PICK)))
+            u1 = rand(key, bounce_dim(bounce, DIM_LIGHT_U))
+            u2 = rand(key, bounce_dim(bounce, DIM_LIGHT_V))
+            lr = lg = lb = 0.0
+            wix = wiy = wiz = 0.0
+            pdf_l = 0.0
+            dist = 0.0
+            use_mis = True
+            cast_shadow = True
+            exclude = 0
+            if idx < n_lamps:
+                lamp = sc.lamps[idx]
+                lflags = int(lamp[L_FLAGS])
+                if bounce <= lamp[L_MAX_BOUNCES]:
+                    wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamp, hx, hy, hz, u1, u2)
+                    pmf = lamp[L_PMF]
+                    use_mis = (lflags & LF_USE_MIS) != 0
+                    cast_shadow = (lflags & LF_CAST_SHADOW) != 0
+                    exclude = _nee_exclude(lflags)
+                    if pdf > 0.0:
+                        pdf_l = pmf * pdf
+                        lr, lg, lb = lr / pdf_l, lg / pdf_l, lb / pdf_l
+                    else:   # delta light: L is already the L/pdf term
+                        use_mis = False
+                        lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
+            else:
+                j = idx - n_lamps
+                tri = sc.emit_tri[j]
+                e0, e1, e2 = sc.verts[sc.tris[tri, 0]], sc.verts[sc.tris[tri, 1]], sc.verts[sc.tris[tri, 2]]
+                qx, qy, qz = sample_triangle_point(e0, e1, e2, u1, u2)
+                lx, ly, lz = qx - hx, qy - hy, qz - hz
+                d2 = lx * lx + ly * ly + lz * lz
+                dist = math.sqrt(d2)
+                if dist > 0.0:
+                    wix, wiy, wiz = lx / dist, ly / dist, lz / dist
+                    fx_ = (e1[1] - e0[1]) * (e2[2] - e0[2]) - (e1[2] - e0[2]) * (e2[1] - e0[1])
+                    fy_ = (e1[2] - e0[2]) * (e2[0] - e0[0]) - (e1[0] - e0[0]) * (e2[2] - e0[2])
+                    fz_ = (e1[0] - e0[0]) * (e2[1] - e0[1]) - (e1[1] - e0[1]) * (e2[0] - e0[0])
+                    # |cos| at the light: cross product length is twice the area.
+                    cos_l = abs(fx_ * wix + fy_ * wiy + fz_ * wiz) / (2.0 * sc.tri_area[tri])
+                    if cos_l > 0.0:
+                        pdf_l = sc.emit_pmf[j] * d2 / (sc.tri_area[tri] * cos_l)
+                        em = sc.materials[sc.mat_index[tri]]
+                        lr, lg, lb = (em[M_EMISSION] / pdf_l, em[M_EMISSION + 1] / pdf_l,
+                                      em[M_EMISSION + 2] / pdf_l)
+                    # The shadow ray must stop before the emitter itself.
+                    dist -= offset_scale(qx, qy, qz)
+            if lr + lg + lb > 0.0 and dist > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
+                wlx = wix * tx + wiy * ty + wiz * tz
+                wly = wix * bx + wiy * by + wiz * bz
+                wlz = wix * nsx + wiy * nsy + wiz * nsz
+                fr, fg, fb, bsdf_pdf = bsdf_eval(mat, wox, woy, woz, wlx, wly, wlz, exclude)
+                w = power_heuristic(pdf_l, bsdf_pdf) if use_mis else 1.0
+                cr = st.beta[i, 0] * fr * lr * w
+                cg = st.beta[i, 1] * fg * lg * w
+                cb = st.beta[i, 2] * fb * lb * w
+                if cr + cg + cb > 0.0:
+                    limit = fcfg[FCFG_CLAMP_DIRECT] if nee_direct else fcfg[FCFG_CLAMP_INDIRECT]
+                    cr, cg, cb = _clamp(cr, cg, cb, limit, stats)
+                    if cast_shadow:
+                        sox, soy, soz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
+                        if math.isinf(dist):
+                            tmax = T_INFINITE
+                        else:
+                            tmax = dist * (1.0 - SHADOW_SHORTEN)
+                        sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
+                        sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = wix, wiy, wiz
+                        sq.t32[n_shadow] = tmax
+                        sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
+                        sq.path[n_shadow] = i
+                        n_shadow += 1
+                    else:
+                        st.radiance[i, 0] += cr
+                        st.radiance[i, 1] += cg
+                        st.radiance[i, 2] += cb
+
+        # -- BSDF sampling: the next ray ---------------------------------------------------
+        wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
+            mat, wox, woy, woz, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
+            rand(key, bounce_dim(bounce, DIM_BSDF_U)), rand(key, bounce_dim(bounce, DIM_BSDF_V)))
+        if pdf <= 0.0 or wr + wg + wb <= 0.0:
+            continue
+        wix = wlx * tx + wly * bx + wlz * nsx
+        wiy = wlx * ty + wly * by + wlz * nsy
+        wiz = wlx * tz + wly * bz + wlz * nsz
+        cos_i_geo = wix * ngx + wiy * ngy + wiz * ngz
+        if (label & LABEL_REFLECT and cos_i_geo <= 0.0) or (label & LABEL_TRANSMIT and cos_i_geo >= 0.0):
+            continue   # shading normal sent the ray through the wrong side of the surface
+        st.beta[i, 0] *= wr
+        st.beta[i, 1] *= wg
+        st.beta[i, 2] *= wb
+
+        # Bounce counting (Cycles' path_state_next): a limit reached here
+        # lets the next vertex collect emission only.
+        new_flags = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_DIFFUSE |
+                              PF_GLOSSY | PF_TRANSMIT | PF_REFLECT)
+        st.bounce[i] = bounce + 1
+        if bounce + 1 > cfg[CFG_MAX_BOUNCE]:
+            new_flags |= PF_TERMINATE
+        if label & LABEL_TRANSMIT:
+            new_flags |= PF_TRANSMIT
+            st.transmission[i] += 1
+            if st.transmission[i] > cfg[CFG_MAX_TRANSMISSION]:
+                new_flags |= PF_TERMINATE
+        elif label & LABEL_DIFFUSE:
+            new_flags |= PF_DIFFUSE | PF_REFLECT
+            st.diffuse[i] += 1
+            if st.diffuse[i] > cfg[CFG_MAX_DIFFUSE]:
+                new_flags |= PF_TERMINATE
+        else:
+            new_flags |= PF_GLOSSY | PF_REFLECT
+            st.glossy[i] += 1
+            if st.glossy[i] > cfg[CFG_MAX_GLOSSY]:
+                new_flags |= PF_TERMINATE
+        if label & LABEL_SINGULAR:
+            new_flags |= PF_MIS_SKIP
+        st.flags[i] = new_flags
+        st.mis_pdf[i] = pdf
+        nox, noy, noz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
+        _set_ray(st, i, nox, noy, noz, wix, wiy, wiz, math.inf)
+        st.self_prim[i] = p
+        st.alive[i] = 1
+    return n_shadow
+
+
+# -- 5. after the shadow rays ------------------------------------------------------------------
+@njit(cache=True, nogil=True)
+def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
+    """Add unoccluded light, write finished paths to the film, compact the rest.
+
+    Returns the number of live paths, now at the front of the state arrays.
+    """
+    for s in range(n_shadow):
+        if not occluded[s]:
+            i = sq.path[s]
+            st.radiance[i, 0] += sq.contrib[s, 0]
+            st.radiance[i, 1] += sq.contrib[s, 1]
+            st.radiance[i, 2] += sq.contrib[s, 2]
+    m = 0
+    for i in range(n):
+        if st.alive[i]:
+            if m != i:
+                _move(st, i, m)
+            m += 1
+        else:
+            _splat(st, i, film_sum, film_sq, film_n)
+    return m
+
+
+@njit(cache=True, inline="always")
+def _splat(st, i, film_sum, film_sq, film_n):
+    pix = st.pixel[i]
+    r, g, b = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+    film_sum[pix, 0] += r
+    film_sum[pix, 1] += g
+    film_sum[pix, 2] += b
+    film_sum[pix, 3] += 1.0 - st.transparency[i]
+    film_sq[pix, 0] += r * r
+    film_sq[pix, 1] += g * g
+    film_sq[pix, 2] += b * b
+    film_n[pix] += 1
+
+
+@njit(cache=True, inline="always")
+def _move(st, i, m):
+    st.key[m] = st.key[i]
+    st.pixel[m] = st.pixel[i]
+    for c in range(3):
+        st.ray_o[m, c] = st.ray_o[i, c]
+        st.ray_d[m, c] = st.ray_d[i, c]
+        st.beta[m, c] = st.beta[i, c]
+        st.radiance[m, c] = st.radiance[i, c]
+        st.o32[m, c] = st.o32[i, c]
+        st.d32[m, c] = st.d32[i, c]
+    st.ray_tmax[m] = st.ray_tmax[i]
+    st.transparency[m] = st.transparency[i]
+    st.bounce[m] = st.bounce[i]
+    st.diffuse[m] = st.diffuse[i]
+    st.glossy[m] = st.glossy[i]
+    st.transmission[m] = st.transmission[i]
+    st.transparent[m] = st.transparent[i]
+    st.flags[m] = st.flags[i]
+    st.mis_pdf[m] = st.mis_pdf[i]
+    st.self_prim[m] = st.self_prim[i]
+    st.t32[m] = st.t32[i]
+
+
+@njit(cache=True, nogil=True)
+def splat_all(n, st, film_sum, film_sq, film_n):
+    """Write all n paths to the film (end of a chunk)."""
+    for i in range(n):
+        _splat(st, i, film_sum, film_sq, film_n)
+
+
+def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, film, stats):
+    """Trace spp samples for each pixel in ``pixels`` to completion.
+
+    ``film`` is ``(film_sum, film_sq, film_n)``.  A chunk always runs to the
+    end (a fraction of a second): stopping paths half-way would keep the
+    short paths and drop the long ones, a bias.  The loop ends when no path
+    is alive; its bound guards against a path re-hitting its origin forever.
+    """
+    film_sum, film_sq, film_n = film
+    n = generate_camera_rays(pixels, spp, film_n, st, sc, cfg)
+    stats[ST_CAMERA_RAYS] += n
+    max_iterations = 4 * (int(cfg[CFG_MAX_BOUNCE]) + int(cfg[CFG_MAX_TRANSPARENT]) + 4)
+    first = True
+    for _ in range(max_iterations):
+        if n == 0:
+            break
+        if not first:
+            stats[ST_BOUNCE_RAYS] += n
+        first = False
+        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n])
+        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, stats)
+        if n_shadow:
+            occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
+            stats[ST_SHADOW_RAYS] += n_shadow
+        else:
+            occluded = np.zeros(0, np.bool_)
+        n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n)
+    splat_all(n, st, film_sum, film_sq, film_n)

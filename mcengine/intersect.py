@@ -1,0 +1,133 @@
+"""Ray-scene intersection: the only module that talks to Embree (embreex).
+
+embreex traces single rays in a C loop that releases the GIL, so two Python
+threads tracing two batches use both cores.  Its limits shape this module:
+
+* rays are float32 and ``tnear`` is fixed at 0, and there are no filter
+  callbacks, so a ray leaving a surface must start slightly off it.
+  :func:`offset_origin` moves the origin along the geometric normal by a
+  distance proportional to the point's magnitude (float32 rounding of the
+  origin and Embree's own arithmetic are relative errors, so a fixed epsilon
+  fails for scenes far from the origin or at millimetre scale);
+* the closest-hit query returns only the primitive id; the integrator
+  recomputes the hit distance and barycentrics in float64 from the triangle
+  (:func:`intersect_triangle`), which is more accurate than Embree's float32
+  values and avoids the allocations of embreex's ``output=1`` mode;
+* a ray that re-hits the triangle it starts on (possible only through
+  rounding, as triangles are flat) is detected by primitive id and traced
+  again from just past that hit (``Accel.closest`` callers do this).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# Relative origin offset: 2^-18 of the largest coordinate magnitude is about
+# 32 float32 ulps, above the rounding of the origin to float32 (half an ulp
+# per coordinate) and of Embree's watertight test (a few ulps), and far below
+# any feature a float32 scene can represent at that magnitude.
+OFFSET_RELATIVE = 2.0 ** -18
+# Absolute floor, for points at the origin itself: float32 normals are
+# accurate to about 1e-7, so 1e-9 m is well resolved and never visible.
+OFFSET_ABSOLUTE = 1e-9
+# Shadow rays stop short of their target by this fraction of their length
+# (plus the target's own offset), so they never hit the emitter they aim at.
+SHADOW_SHORTEN = 2.0 ** -16
+T_INFINITE = 1e30   # "no hit" distance; Embree's float32 tfar for unbounded rays
+
+
+class Accel:
+    """Embree BVH over the scene triangles.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float32
+    triangles : (T, 3) int32
+    """
+
+    def __init__(self, vertices, triangles):
+        self.num_triangles = int(len(triangles))
+        self._scene = None
+        if self.num_triangles:
+            from embreex import rtcore_scene
+            from embreex.mesh_construction import TriangleMesh
+            self._scene = rtcore_scene.EmbreeScene()
+            TriangleMesh(self._scene, np.ascontiguousarray(vertices, np.float32),
+                         np.ascontiguousarray(triangles, np.int32))
+            # Commit now: embreex commits on the first query, which is not
+            # safe to do from two threads at once.
+            self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
+
+    def closest(self, origins, directions, tfar):
+        """Primitive id of the closest hit within (0, tfar), or -1.
+
+        origins, directions : (n, 3) float32; tfar : (n,) float32.
+        """
+        n = origins.shape[0]
+        if self._scene is None or n == 0:
+            return np.full(n, -1, np.int32)
+        return self._scene.run(origins, directions, dists=tfar, query="INTERSECT")
+
+    def occluded(self, origins, directions, tfar):
+        """True where something blocks the segment (0, tfar)."""
+        n = origins.shape[0]
+        if self._scene is None or n == 0:
+            return np.zeros(n, np.bool_)
+        return self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
+
+
+@njit(cache=True, inline="always")
+def offset_scale(px, py, pz):
+    """Offset distance for a ray leaving point p (see OFFSET_RELATIVE)."""
+    m = max(abs(px), abs(py), abs(pz))
+    return OFFSET_RELATIVE * m + OFFSET_ABSOLUTE
+
+
+@njit(cache=True, inline="always")
+def offset_origin(px, py, pz, ngx, ngy, ngz, dx, dy, dz):
+    """Move p off its surface to the side of the geometric normal ng that d leaves to."""
+    s = offset_scale(px, py, pz)
+    if ngx * dx + ngy * dy + ngz * dz < 0.0:
+        s = -s
+    return px + s * ngx, py + s * ngy, pz + s * ngz
+
+
+@njit(cache=True, inline="always")
+def intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2):
+    """Plane hit of a ray with a triangle, in float64.
+
+    Returns ``(t, b1, b2)`` with barycentrics clamped into the triangle (the
+    caller already knows from Embree that the ray hits it; clamping absorbs
+    the difference between Embree's float32 test and this one at edges).
+    ``t`` is NaN if the ray is parallel to the plane.
+    """
+    e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
+    e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+    nx = e1y * e2z - e1z * e2y
+    ny = e1z * e2x - e1x * e2z
+    nz = e1x * e2y - e1y * e2x
+    denom = nx * dx + ny * dy + nz * dz
+    if denom == 0.0:
+        return math.nan, 0.0, 0.0
+    t = (nx * (v0[0] - ox) + ny * (v0[1] - oy) + nz * (v0[2] - oz)) / denom
+    # Barycentrics of the plane hit by projecting onto the edges (Gram matrix).
+    px, py, pz = ox + t * dx - v0[0], oy + t * dy - v0[1], oz + t * dz - v0[2]
+    d00 = e1x * e1x + e1y * e1y + e1z * e1z
+    d01 = e1x * e2x + e1y * e2y + e1z * e2z
+    d11 = e2x * e2x + e2y * e2y + e2z * e2z
+    d20 = px * e1x + py * e1y + pz * e1z
+    d21 = px * e2x + py * e2y + pz * e2z
+    g = d00 * d11 - d01 * d01
+    if g <= 0.0:
+        return t, 1.0 / 3.0, 1.0 / 3.0
+    b1 = (d11 * d20 - d01 * d21) / g
+    b2 = (d00 * d21 - d01 * d20) / g
+    b1 = min(max(b1, 0.0), 1.0)
+    b2 = min(max(b2, 0.0), 1.0)
+    s = b1 + b2
+    if s > 1.0:
+        b1 /= s
+        b2 /= s
+    return t, b1, b2

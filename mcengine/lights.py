@@ -1,0 +1,422 @@
+"""Lights: Blender lamps and emissive triangles, in Cycles' units.
+
+Lamps are packed into a float64 table (``pack_lights``), a row per lamp with
+the columns ``L_*``; emissive triangles are listed separately.  One discrete
+distribution over "all lamps, then all emissive triangles" picks the light
+for next-event estimation, in proportion to an estimate of its power.
+
+Per lamp type (Cycles 5.0, intern/cycles/kernel/light/ and scene/light.cpp):
+
+* point, radius 0: a delta light of intensity P / (4 pi) W/sr;
+* point, radius r, soft falloff (the default): a disk of radius r that always
+  faces the shading point, radiance P / (4 pi^2 r^2);
+* point, radius r, no soft falloff: a sphere of the same radiance;
+* spot: a point light (any of the three) times the cone attenuation
+  smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) * blend)), with a
+  measured from the lamp's -Z through its inverse transform (so non-uniform
+  object scale makes the cone elliptical); the power is not concentrated
+  into the cone;
+* sun: irradiance S; with angle > 0 a disk of directions of half-angle
+  angle/2 and radiance S / (pi sin^2(angle/2)), otherwise a delta direction;
+* area: one-sided (emits into local -Z), rectangle or ellipse whose extents
+  are multiplied by the object scale, radiance P / (pi A) (P / pi without
+  ``normalize``), with the ``spread`` attenuation;
+* emissive triangles: radiance colour x strength on both sides.
+
+Lamps are transparent to rays: a ray that passes through a lamp collects its
+light and goes on (Cycles counts it as a transparent bounce).  Shadow rays
+ignore lamps.  Lamps with ``use_mis`` off are invisible to BSDF rays.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .sampling import (disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf,
+                       uniform_triangle)
+
+LT_POINT = 0
+LT_SPOT = 1
+LT_SUN = 2
+LT_AREA = 3
+
+# Lamp table columns.
+L_TYPE = 0
+L_POS = 1            # 3: position
+L_AX = 4             # 3: unit local +X (world)
+L_AY = 7             # 3: unit local +Y (world)
+L_AZ = 10            # 3: unit local +Z (world); lamps emit along -Z
+L_RADIANCE = 13      # 3: surface radiance (intensity for radius-0 points, irradiance for delta suns)
+L_RADIUS = 16        # point/spot radius
+L_DISK = 17          # 1: point/spot radius is a disk facing the shading point (soft falloff)
+L_HALF_X = 18        # area half extents (object scale included)
+L_HALF_Y = 19
+L_ELLIPSE = 20       # area: 1 for DISK/ELLIPSE
+L_AREA = 21          # area of the emitting surface
+L_SPOT_COS = 22      # cos(spot_size / 2)
+L_SPOT_SMOOTH = 23   # 1 / ((1 - cos) * blend), 0 for a hard edge
+L_SPOT_INV = 24      # 9: world-to-local 3x3 of the spot (rows), scale included
+L_SUN_COS = 33       # cos(angle / 2); 1 for a delta sun
+L_SPREAD_TAN = 34    # tan(spread / 2); negative: no spread attenuation
+L_SPREAD_NORM = 35   # 1 / (tan(spread/2) - spread/2)
+L_FLAGS = 36
+L_MAX_BOUNCES = 37
+L_PMF = 38           # probability of picking this lamp for NEE
+LIGHT_STRIDE = 39
+
+# L_FLAGS bits.
+LF_CAST_SHADOW = 1
+LF_USE_MIS = 2
+LF_VIS_CAMERA = 4
+LF_VIS_DIFFUSE = 8
+LF_VIS_GLOSSY = 16
+LF_VIS_TRANSMISSION = 32
+
+
+def _unit(v):
+    n = np.linalg.norm(v)
+    return v / n if n > 0 else v
+
+
+def _spread_normalisation(half):
+    """1 / (tan(h) - h), with its Taylor form for small h (as Cycles does)."""
+    if half < 0.05:
+        x2 = half * half
+        return 1.0 / (half * x2 * (1.0 / 3.0 + x2 * (2.0 / 15.0 + x2 * 17.0 / 315.0)))
+    return 1.0 / (math.tan(half) - half)
+
+
+def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Lamp table (N, LIGHT_STRIDE) and the power estimate of each lamp.
+
+    ``scene_radius`` bounds the geometry; a sun's power is its irradiance times
+    the scene's cross-section.
+    """
+    table = np.zeros((len(lights), LIGHT_STRIDE))
+    power = np.zeros(len(lights))
+    for i, li in enumerate(lights):
+        m = np.asarray(li.matrix_world, np.float64)
+        row = table[i]
+        strength = np.asarray(li.strength, np.float64)
+        scale = np.linalg.norm(m[:3, :3], axis=0)
+        row[L_POS:L_POS + 3] = m[:3, 3]
+        ax, ay, az = _unit(m[:3, 0]), _unit(m[:3, 1]), _unit(m[:3, 2])
+        row[L_AX:L_AX + 3], row[L_AY:L_AY + 3], row[L_AZ:L_AZ + 3] = ax, ay, az
+        flags = 0
+        flags |= LF_CAST_SHADOW if li.cast_shadow else 0
+        flags |= LF_USE_MIS if li.use_mis else 0
+        flags |= LF_VIS_CAMERA if li.visible_camera else 0
+        flags |= LF_VIS_DIFFUSE if li.visible_diffuse else 0
+        flags |= LF_VIS_GLOSSY if li.visible_glossy else 0
+        flags |= LF_VIS_TRANSMISSION if li.visible_transmission else 0
+        row[L_MAX_BOUNCES] = li.max_bounces
+        row[L_SPREAD_TAN] = -1.0
+        row[L_SUN_COS] = 1.0
+        if li.type in ("POINT", "SPOT"):
+            row[L_TYPE] = LT_POINT if li.type == "POINT" else LT_SPOT
+            r = max(float(li.radius), 0.0)
+            row[L_RADIUS] = r
+            row[L_DISK] = 1.0 if li.soft_falloff else 0.0
+            if r > 0.0:
+                row[L_AREA] = math.pi * r * r if li.soft_falloff else 4.0 * math.pi * r * r
+                row[L_RADIANCE:L_RADIANCE + 3] = strength / (4.0 * math.pi * math.pi * r * r)
+            else:
+                row[L_RADIANCE:L_RADIANCE + 3] = strength / (4.0 * math.pi)
+            power[i] = strength.mean()
+            if li.type == "SPOT":
+                c = math.cos(0.5 * float(li.spot_size))
+                row[L_SPOT_COS] = c
+                blend = float(li.spot_blend)
+                row[L_SPOT_SMOOTH] = 1.0 / ((1.0 - c) * blend) if blend > 0.0 and c < 1.0 else 0.0
+                inv = np.linalg.inv(m[:3, :3]) if abs(np.linalg.det(m[:3, :3])) > 0 else np.eye(3)
+                row[L_SPOT_INV:L_SPOT_INV + 9] = inv.reshape(-1)
+                # The cone holds (1 - c)/2 of the sphere's directions at most.
+                power[i] *= max(0.5 * (1.0 - c), 1e-3)
+        elif li.type == "SUN":
+            row[L_TYPE] = LT_SUN
+            half = 0.5 * float(li.angle)
+            if half > 0.0:
+                row[L_SUN_COS] = math.cos(half)
+                row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * math.sin(half) ** 2)
+            else:
+                row[L_RADIANCE:L_RADIANCE + 3] = strength
+            power[i] = strength.mean() * math.pi * scene_radius ** 2
+        elif li.type == "AREA":
+            row[L_TYPE] = LT_AREA
+            sx = float(li.size_x)
+            sy = float(li.size_x if li.shape in ("SQUARE", "DISK") else li.size_y)
+            hx, hy = 0.5 * sx * scale[0], 0.5 * sy * scale[1]
+            row[L_HALF_X], row[L_HALF_Y] = hx, hy
+            ellipse = li.shape in ("DISK", "ELLIPSE")
+            row[L_ELLIPSE] = 1.0 if ellipse else 0.0
+            area = 4.0 * hx * hy * (math.pi / 4.0 if ellipse else 1.0)
+            row[L_AREA] = area
+            if area > 0.0:
+                norm_area = area if li.normalize else 1.0
+                row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * norm_area)
+                power[i] = strength.mean() * (1.0 if li.normalize else area)
+            spread = float(li.spread)
+            if spread < math.pi - 1e-6:
+                half = 0.5 * max(spread, 1e-4)
+                row[L_SPREAD_TAN] = math.tan(half)
+                row[L_SPREAD_NORM] = _spread_normalisation(half)
+        row[L_FLAGS] = flags
+    return table, np.maximum(power, 0.0)
+
+
+def light_distribution(lamp_power, tri_power):
+    """CDF over lamps then emissive triangles; (cdf, lamp pmf, triangle pmf)."""
+    w = np.concatenate([lamp_power, tri_power]).astype(np.float64)
+    total = w.sum()
+    if total <= 0.0:
+        return np.zeros(len(w) + 1), np.zeros(len(lamp_power)), np.zeros(len(tri_power))
+    pmf = w / total
+    cdf = np.concatenate([[0.0], np.cumsum(pmf)])
+    cdf[-1] = 1.0
+    return cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):]
+
+
+@njit(cache=True, inline="always")
+def pick_light(cdf, u):
+    """Index i with cdf[i] <= u < cdf[i+1] (binary search), skipping zero-width bins."""
+    lo, hi = 0, cdf.shape[0] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if cdf[mid] <= u:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True, inline="always")
+def _smoothstep(t):
+    if t <= 0.0:
+        return 0.0
+    if t >= 1.0:
+        return 1.0
+    return t * t * (3.0 - 2.0 * t)
+
+
+@njit(cache=True, inline="always")
+def spot_attenuation(lamp, ex, ey, ez):
+    """Cone attenuation for the emission direction e (light towards the point)."""
+    inv = lamp[L_SPOT_INV:L_SPOT_INV + 9]
+    lx = inv[0] * ex + inv[1] * ey + inv[2] * ez
+    ly = inv[3] * ex + inv[4] * ey + inv[5] * ez
+    lz = inv[6] * ex + inv[7] * ey + inv[8] * ez
+    ln = math.sqrt(lx * lx + ly * ly + lz * lz)
+    if ln == 0.0:
+        return 0.0
+    cos_a = -lz / ln
+    c = lamp[L_SPOT_COS]
+    if lamp[L_SPOT_SMOOTH] == 0.0:
+        return 1.0 if cos_a > c else 0.0
+    return _smoothstep((cos_a - c) * lamp[L_SPOT_SMOOTH])
+
+
+@njit(cache=True, inline="always")
+def area_spread(lamp, cos_l):
+    """Spread attenuation at emission angle theta (cos_l = cos theta)."""
+    t = lamp[L_SPREAD_TAN]
+    if t < 0.0:
+        return 1.0
+    if cos_l <= 0.0:
+        return 0.0
+    tan_theta = math.sqrt(max(0.0, 1.0 - cos_l * cos_l)) / cos_l
+    return max(t - tan_theta, 0.0) * lamp[L_SPREAD_NORM]
+
+
+@njit(cache=True)
+def sample_lamp(lamp, px, py, pz, u1, u2):
+    """Sample lamp radiance arriving at p.
+
+    Returns ``(wix, wiy, wiz, dist, Lr, Lg, Lb, pdf)``: the unit direction
+    to the light, the distance to the sampled point (``inf`` for suns), the
+    radiance arriving along wi (attenuations included) and the solid-angle
+    pdf of wi.  ``pdf == 0`` with a non-zero L means a delta light whose L is
+    already the irradiance-equivalent (L/pdf term); ``L == 0`` means no light.
+    """
+    typ = int(lamp[L_TYPE])
+    if typ == LT_SUN:
+        azx, azy, azz = lamp[L_AZ], lamp[L_AZ + 1], lamp[L_AZ + 2]
+        cos_max = lamp[L_SUN_COS]
+        if cos_max >= 1.0:
+            return azx, azy, azz, math.inf, lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2], 0.0
+        x, y, z = uniform_cone(u1, u2, cos_max)
+        tx, ty, tz, bx, by, bz = orthonormal_basis(azx, azy, azz)
+        wx = x * tx + y * bx + z * azx
+        wy = x * ty + y * by + z * azy
+        wz = x * tz + y * bz + z * azz
+        return (wx, wy, wz, math.inf, lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2],
+                uniform_cone_pdf(cos_max))
+
+    cx, cy, cz = lamp[L_POS], lamp[L_POS + 1], lamp[L_POS + 2]
+    if typ == LT_AREA:
+        hx, hy = lamp[L_HALF_X], lamp[L_HALF_Y]
+        if lamp[L_AREA] <= 0.0:
+            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if lamp[L_ELLIPSE] > 0.0:
+            a, b = disk_concentric(u1, u2)
+        else:
+            a, b = 2.0 * u1 - 1.0, 2.0 * u2 - 1.0
+        qx = cx + a * hx * lamp[L_AX] + b * hy * lamp[L_AY]
+        qy = cy + a * hx * lamp[L_AX + 1] + b * hy * lamp[L_AY + 1]
+        qz = cz + a * hx * lamp[L_AX + 2] + b * hy * lamp[L_AY + 2]
+        dx, dy, dz = qx - px, qy - py, qz - pz
+        d2 = dx * dx + dy * dy + dz * dz
+        dist = math.sqrt(d2)
+        if dist == 0.0:
+            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        wx, wy, wz = dx / dist, dy / dist, dz / dist
+        # One-sided: the lamp emits along -Z, so wi (towards it) must go along +Z.
+        cos_l = wx * lamp[L_AZ] + wy * lamp[L_AZ + 1] + wz * lamp[L_AZ + 2]
+        if cos_l <= 0.0:
+            return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
+        s = area_spread(lamp, cos_l)
+        pdf = d2 / (lamp[L_AREA] * cos_l)
+        return (wx, wy, wz, dist, s * lamp[L_RADIANCE], s * lamp[L_RADIANCE + 1],
+                s * lamp[L_RADIANCE + 2], pdf)
+
+    # Point and spot lamps.
+    r = lamp[L_RADIUS]
+    dx, dy, dz = cx - px, cy - py, cz - pz
+    d2 = dx * dx + dy * dy + dz * dz
+    d = math.sqrt(d2)
+    if d == 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    nx, ny, nz = dx / d, dy / d, dz / d
+    if r <= 0.0:
+        # Delta light: return intensity / d^2 as the L/pdf term.
+        att = 1.0
+        if typ == LT_SPOT:
+            att = spot_attenuation(lamp, -nx, -ny, -nz)
+        k = att / d2
+        return (nx, ny, nz, d, k * lamp[L_RADIANCE], k * lamp[L_RADIANCE + 1],
+                k * lamp[L_RADIANCE + 2], 0.0)
+    if d <= r:
+        return nx, ny, nz, d, 0.0, 0.0, 0.0, 0.0   # inside the lamp: no defined direction
+    if lamp[L_DISK] > 0.0:
+        # Disk of radius r through the centre, facing p.
+        a, b = disk_concentric(u1, u2)
+        tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
+        qx = cx + r * (a * tx + b * bx)
+        qy = cy + r * (a * ty + b * by)
+        qz = cz + r * (a * tz + b * bz)
+        ex, ey, ez = qx - px, qy - py, qz - pz
+        q2 = ex * ex + ey * ey + ez * ez
+        dist = math.sqrt(q2)
+        wx, wy, wz = ex / dist, ey / dist, ez / dist
+        cos_l = wx * nx + wy * ny + wz * nz
+        if cos_l <= 0.0:
+            return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
+        pdf = q2 / (math.pi * r * r * cos_l)
+    else:
+        # Sphere: uniform over the cone of directions it subtends.
+        sin2 = r * r / d2
+        cos_max = math.sqrt(max(0.0, 1.0 - sin2))
+        x, y, z = uniform_cone(u1, u2, cos_max)
+        tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
+        wx = x * tx + y * bx + z * nx
+        wy = x * ty + y * by + z * ny
+        wz = x * tz + y * bz + z * nz
+        # Distance to the near side of the sphere along wi.
+        b_ = d * z
+        disc = r * r - (d2 - b_ * b_)
+        dist = b_ - math.sqrt(max(disc, 0.0))
+        pdf = uniform_cone_pdf(cos_max)
+    att = 1.0
+    if typ == LT_SPOT:
+        att = spot_attenuation(lamp, -wx, -wy, -wz)
+    return (wx, wy, wz, dist, att * lamp[L_RADIANCE], att * lamp[L_RADIANCE + 1],
+            att * lamp[L_RADIANCE + 2], pdf)
+
+
+@njit(cache=True)
+def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
+    """A ray through a lamp: ``(t, Lr, Lg, Lb, pdf)``, t = inf if it misses.
+
+    ``pdf`` is the solid-angle pdf with which :func:`sample_lamp` would pick
+    this direction from the ray origin (for MIS).  Suns are handled by
+    :func:`sun_radiance` on escaped rays.
+    """
+    typ = int(lamp[L_TYPE])
+    if typ == LT_SUN:
+        return math.inf, 0.0, 0.0, 0.0, 0.0
+    cx, cy, cz = lamp[L_POS], lamp[L_POS + 1], lamp[L_POS + 2]
+    if typ == LT_AREA:
+        azx, azy, azz = lamp[L_AZ], lamp[L_AZ + 1], lamp[L_AZ + 2]
+        cos_l = dx * azx + dy * azy + dz * azz       # > 0: the ray meets the emitting side
+        if cos_l <= 0.0 or lamp[L_AREA] <= 0.0:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        t = ((cx - ox) * azx + (cy - oy) * azy + (cz - oz) * azz) / cos_l
+        if t <= 0.0 or t >= tmax:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        hx, hy, hz = ox + t * dx - cx, oy + t * dy - cy, oz + t * dz - cz
+        a = (hx * lamp[L_AX] + hy * lamp[L_AX + 1] + hz * lamp[L_AX + 2]) / lamp[L_HALF_X]
+        b = (hx * lamp[L_AY] + hy * lamp[L_AY + 1] + hz * lamp[L_AY + 2]) / lamp[L_HALF_Y]
+        if lamp[L_ELLIPSE] > 0.0:
+            if a * a + b * b > 1.0:
+                return math.inf, 0.0, 0.0, 0.0, 0.0
+        elif abs(a) > 1.0 or abs(b) > 1.0:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        s = area_spread(lamp, cos_l)
+        pdf = t * t / (lamp[L_AREA] * cos_l)
+        return t, s * lamp[L_RADIANCE], s * lamp[L_RADIANCE + 1], s * lamp[L_RADIANCE + 2], pdf
+
+    r = lamp[L_RADIUS]
+    if r <= 0.0:
+        return math.inf, 0.0, 0.0, 0.0, 0.0
+    px, py, pz = cx - ox, cy - oy, cz - oz
+    d2 = px * px + py * py + pz * pz
+    if d2 <= r * r:
+        return math.inf, 0.0, 0.0, 0.0, 0.0
+    d = math.sqrt(d2)
+    if lamp[L_DISK] > 0.0:
+        # Disk through the centre facing the ray origin.
+        nx, ny, nz = px / d, py / d, pz / d
+        cos_l = dx * nx + dy * ny + dz * nz
+        if cos_l <= 0.0:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        t = d / cos_l
+        if t >= tmax:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        hx, hy, hz = ox + t * dx - cx, oy + t * dy - cy, oz + t * dz - cz
+        if hx * hx + hy * hy + hz * hz > r * r:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        pdf = t * t / (math.pi * r * r * cos_l)
+    else:
+        b_ = px * dx + py * dy + pz * dz
+        disc = r * r - (d2 - b_ * b_)
+        if disc < 0.0 or b_ <= 0.0:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        t = b_ - math.sqrt(disc)
+        if t <= 0.0 or t >= tmax:
+            return math.inf, 0.0, 0.0, 0.0, 0.0
+        pdf = uniform_cone_pdf(math.sqrt(max(0.0, 1.0 - r * r / d2)))
+    att = 1.0
+    if typ == LT_SPOT:
+        att = spot_attenuation(lamp, -dx, -dy, -dz)
+    return t, att * lamp[L_RADIANCE], att * lamp[L_RADIANCE + 1], att * lamp[L_RADIANCE + 2], pdf
+
+
+@njit(cache=True, inline="always")
+def sun_radiance(lamp, dx, dy, dz):
+    """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d."""
+    cos_max = lamp[L_SUN_COS]
+    if cos_max >= 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    if dx * lamp[L_AZ] + dy * lamp[L_AZ + 1] + dz * lamp[L_AZ + 2] < cos_max:
+        return 0.0, 0.0, 0.0, 0.0
+    return lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2], uniform_cone_pdf(cos_max)
+
+
+@njit(cache=True, inline="always")
+def sample_triangle_point(v0, v1, v2, u1, u2):
+    b1, b2 = uniform_triangle(u1, u2)
+    b0 = 1.0 - b1 - b2
+    return (b0 * v0[0] + b1 * v1[0] + b2 * v2[0],
+            b0 * v0[1] + b1 * v1[1] + b2 * v2[1],
+            b0 * v0[2] + b1 * v1[2] + b2 * v2[2])

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .jit import device
 
 from .sampling import cosine_hemisphere
 
@@ -59,18 +59,18 @@ def pack_materials(materials) -> np.ndarray:
     return table
 
 
-@njit(cache=True, inline="always")
+@device
 def bsdf_has_lobes(mat):
     return mat[M_DIFFUSE_WEIGHT] > 0.0
 
 
-@njit(cache=True, inline="always")
+@device
 def bsdf_labels(mat):
     """Labels of all lobes of the material (what light visibility checks against)."""
     return LABEL_REFLECT | LABEL_DIFFUSE if mat[M_DIFFUSE_WEIGHT] > 0.0 else LABEL_NONE
 
 
-@njit(cache=True, inline="always")
+@device
 def bsdf_eval(mat, wox, woy, woz, wix, wiy, wiz, exclude):
     """(f*|cos| r, g, b, pdf) for local directions wo, wi."""
     if mat[M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0 or wiz <= 0.0:
@@ -81,7 +81,7 @@ def bsdf_eval(mat, wox, woy, woz, wix, wiy, wiz, exclude):
     return mat[M_BASE] * pdf, mat[M_BASE + 1] * pdf, mat[M_BASE + 2] * pdf, pdf
 
 
-@njit(cache=True, inline="always")
+@device
 def bsdf_sample(mat, wox, woy, woz, u_lobe, u1, u2):
     """(wix, wiy, wiz, weight r, g, b, pdf, label) for local wo."""
     if mat[M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .jit import device
 
 CAM_PERSP = 0
 CAM_ORTHO = 1
@@ -94,7 +94,7 @@ def pack_camera(cam, film) -> np.ndarray:
     return p
 
 
-@njit(cache=True)
+@device
 def camera_ray(cam, rx, ry):
     """World-space ray through raster position (rx, ry).
 

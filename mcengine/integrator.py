@@ -29,7 +29,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from .jit import device, kernel
 
 from .bsdf import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
                    M_EMISSION, M_EMISSIVE, bsdf_eval, bsdf_has_lobes, bsdf_sample)
@@ -154,7 +154,7 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
 
 
 # -- 1. camera rays ----------------------------------------------------------------------
-@njit(cache=True, nogil=True)
+@kernel
 def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     """Start ``spp`` paths for each film pixel in ``pixels``; returns the path count.
 
@@ -204,7 +204,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
 
 
 # -- helpers ---------------------------------------------------------------------------------
-@njit(cache=True, inline="always")
+@device
 def _clamp(r, g, b, limit, stats):
     """Cycles' film_clamp_light: drop non-finite values, cap |r|+|g|+|b| at limit."""
     if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
@@ -217,7 +217,7 @@ def _clamp(r, g, b, limit, stats):
     return r, g, b
 
 
-@njit(cache=True, inline="always")
+@device
 def _add(st, i, r, g, b, direct, fcfg, stats):
     limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
     r, g, b = _clamp(r, g, b, limit, stats)
@@ -226,7 +226,7 @@ def _add(st, i, r, g, b, direct, fcfg, stats):
     st.radiance[i, 2] += b
 
 
-@njit(cache=True, inline="always")
+@device
 def _lamp_visible_to_ray(flags, lamp_flags):
     """Cycles' is_light_shader_visible_to_path for a ray of the given path flags."""
     if flags & PF_CAMERA:
@@ -242,7 +242,7 @@ def _lamp_visible_to_ray(flags, lamp_flags):
     return True
 
 
-@njit(cache=True, inline="always")
+@device
 def _nee_exclude(lamp_flags):
     """BSDF lobes a light must not illuminate (its ray-visibility switches)."""
     ex = 0
@@ -255,7 +255,7 @@ def _nee_exclude(lamp_flags):
     return ex
 
 
-@njit(cache=True, inline="always")
+@device
 def _set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
     st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2] = ox, oy, oz
     st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2] = dx, dy, dz
@@ -266,7 +266,7 @@ def _set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
 
 
 # -- 3. shading ------------------------------------------------------------------------------
-@njit(cache=True, nogil=True)
+@kernel
 def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
     """Shade the hits of the n live rays; returns the number of queued shadow rays."""
     n_shadow = 0
@@ -550,7 +550,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
 
 # -- 5. after the shadow rays ------------------------------------------------------------------
-@njit(cache=True, nogil=True)
+@kernel
 def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
     """Add unoccluded light, write finished paths to the film, compact the rest.
 
@@ -573,7 +573,7 @@ def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
     return m
 
 
-@njit(cache=True, inline="always")
+@device
 def _splat(st, i, film_sum, film_sq, film_n):
     pix = st.pixel[i]
     r, g, b = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
@@ -587,7 +587,7 @@ def _splat(st, i, film_sum, film_sq, film_n):
     film_n[pix] += 1
 
 
-@njit(cache=True, inline="always")
+@device
 def _move(st, i, m):
     st.key[m] = st.key[i]
     st.pixel[m] = st.pixel[i]
@@ -611,7 +611,7 @@ def _move(st, i, m):
     st.t32[m] = st.t32[i]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def splat_all(n, st, film_sum, film_sq, film_n):
     """Write all n paths to the film (end of a chunk)."""
     for i in range(n):

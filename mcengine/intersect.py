@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .jit import device
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about
 # 32 float32 ulps, above the rounding of the origin to float32 (half an ulp
@@ -78,14 +78,14 @@ class Accel:
         return self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
 
 
-@njit(cache=True, inline="always")
+@device
 def offset_scale(px, py, pz):
     """Offset distance for a ray leaving point p (see OFFSET_RELATIVE)."""
     m = max(abs(px), abs(py), abs(pz))
     return OFFSET_RELATIVE * m + OFFSET_ABSOLUTE
 
 
-@njit(cache=True, inline="always")
+@device
 def offset_origin(px, py, pz, ngx, ngy, ngz, dx, dy, dz):
     """Move p off its surface to the side of the geometric normal ng that d leaves to."""
     s = offset_scale(px, py, pz)
@@ -94,7 +94,7 @@ def offset_origin(px, py, pz, ngx, ngy, ngz, dx, dy, dz):
     return px + s * ngx, py + s * ngy, pz + s * ngz
 
 
-@njit(cache=True, inline="always")
+@device
 def intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2):
     """Plane hit of a ray with a triangle, in float64.
 

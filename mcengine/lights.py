@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .jit import device
 
 from .sampling import (disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf,
                        uniform_triangle)
@@ -178,7 +178,7 @@ def light_distribution(lamp_power, tri_power):
     return cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):]
 
 
-@njit(cache=True, inline="always")
+@device
 def pick_light(cdf, u):
     """Index i with cdf[i] <= u < cdf[i+1] (binary search), skipping zero-width bins."""
     lo, hi = 0, cdf.shape[0] - 1
@@ -191,7 +191,7 @@ def pick_light(cdf, u):
     return lo
 
 
-@njit(cache=True, inline="always")
+@device
 def _smoothstep(t):
     if t <= 0.0:
         return 0.0
@@ -200,7 +200,7 @@ def _smoothstep(t):
     return t * t * (3.0 - 2.0 * t)
 
 
-@njit(cache=True, inline="always")
+@device
 def spot_attenuation(lamp, ex, ey, ez):
     """Cone attenuation for the emission direction e (light towards the point)."""
     inv = lamp[L_SPOT_INV:L_SPOT_INV + 9]
@@ -217,7 +217,7 @@ def spot_attenuation(lamp, ex, ey, ez):
     return _smoothstep((cos_a - c) * lamp[L_SPOT_SMOOTH])
 
 
-@njit(cache=True, inline="always")
+@device
 def area_spread(lamp, cos_l):
     """Spread attenuation at emission angle theta (cos_l = cos theta)."""
     t = lamp[L_SPREAD_TAN]
@@ -229,7 +229,7 @@ def area_spread(lamp, cos_l):
     return max(t - tan_theta, 0.0) * lamp[L_SPREAD_NORM]
 
 
-@njit(cache=True)
+@device
 def sample_lamp(lamp, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
 
@@ -334,7 +334,7 @@ def sample_lamp(lamp, px, py, pz, u1, u2):
             att * lamp[L_RADIANCE + 2], pdf)
 
 
-@njit(cache=True)
+@device
 def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
     """A ray through a lamp: ``(t, Lr, Lg, Lb, pdf)``, t = inf if it misses.
 
@@ -402,7 +402,7 @@ def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
     return t, att * lamp[L_RADIANCE], att * lamp[L_RADIANCE + 1], att * lamp[L_RADIANCE + 2], pdf
 
 
-@njit(cache=True, inline="always")
+@device
 def sun_radiance(lamp, dx, dy, dz):
     """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d."""
     cos_max = lamp[L_SUN_COS]
@@ -413,7 +413,7 @@ def sun_radiance(lamp, dx, dy, dz):
     return lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2], uniform_cone_pdf(cos_max)
 
 
-@njit(cache=True, inline="always")
+@device
 def sample_triangle_point(v0, v1, v2, u1, u2):
     b1, b2 = uniform_triangle(u1, u2)
     b0 = 1.0 - b1 - b2

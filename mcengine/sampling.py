@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .jit import device
 
 # -- dimensions ----------------------------------------------------------------
 # Camera dimensions come first, then a block of DIMS_PER_BOUNCE numbers for
@@ -44,7 +44,7 @@ _M2 = np.uint64(0x94D049BB133111EB)
 _INV_2_53 = 1.0 / 9007199254740992.0
 
 
-@njit(cache=True, inline="always")
+@device
 def mix64(x):
     """splitmix64 finaliser: a bijective 64-bit hash with full avalanche."""
     x = (x ^ (x >> np.uint64(30))) * _M1
@@ -52,7 +52,7 @@ def mix64(x):
     return x ^ (x >> np.uint64(31))
 
 
-@njit(cache=True, inline="always")
+@device
 def path_key(seed, pixel, sample):
     """64-bit key of one path sample: (seed, pixel index, sample index)."""
     k = mix64(np.uint64(seed) * _K_SAMPLE + np.uint64(0x632BE59BD9B4E019))
@@ -60,20 +60,20 @@ def path_key(seed, pixel, sample):
     return mix64(k ^ (np.uint64(sample) * _K_SAMPLE))
 
 
-@njit(cache=True, inline="always")
+@device
 def rand(key, dim):
     """Uniform float64 in [0, 1) for dimension ``dim`` of the path ``key``."""
     h = mix64(key ^ (np.uint64(dim + 1) * _K_DIM))
     return float(h >> np.uint64(11)) * _INV_2_53
 
 
-@njit(cache=True, inline="always")
+@device
 def bounce_dim(bounce, which):
     return DIM_BOUNCE_BASE + bounce * DIMS_PER_BOUNCE + which
 
 
 # -- warps -----------------------------------------------------------------------
-@njit(cache=True, inline="always")
+@device
 def disk_concentric(u1, u2):
     """Shirley-Chiu concentric map of [0,1)^2 to the unit disk (uniform, low distortion)."""
     a = 2.0 * u1 - 1.0
@@ -89,7 +89,7 @@ def disk_concentric(u1, u2):
     return r * math.cos(phi), r * math.sin(phi)
 
 
-@njit(cache=True, inline="always")
+@device
 def disk_polar(u1, u2):
     """Uniform unit disk by polar coordinates: r = sqrt(u1), not r = u1."""
     r = math.sqrt(u1)
@@ -97,7 +97,7 @@ def disk_polar(u1, u2):
     return r * math.cos(phi), r * math.sin(phi)
 
 
-@njit(cache=True, inline="always")
+@device
 def cosine_hemisphere(u1, u2):
     """Direction around +z with density cos(theta)/pi (Malley's method)."""
     x, y = disk_concentric(u1, u2)
@@ -105,12 +105,12 @@ def cosine_hemisphere(u1, u2):
     return x, y, z
 
 
-@njit(cache=True, inline="always")
+@device
 def cosine_hemisphere_pdf(cos_theta):
     return max(cos_theta, 0.0) / math.pi
 
 
-@njit(cache=True, inline="always")
+@device
 def uniform_sphere(u1, u2):
     z = 1.0 - 2.0 * u1
     r = math.sqrt(max(0.0, 1.0 - z * z))
@@ -118,7 +118,7 @@ def uniform_sphere(u1, u2):
     return r * math.cos(phi), r * math.sin(phi), z
 
 
-@njit(cache=True, inline="always")
+@device
 def uniform_cone(u1, u2, cos_max):
     """Direction around +z, uniform over the cap cos(theta) >= cos_max.
 
@@ -133,12 +133,12 @@ def uniform_cone(u1, u2, cos_max):
     return r * math.cos(phi), r * math.sin(phi), z
 
 
-@njit(cache=True, inline="always")
+@device
 def uniform_cone_pdf(cos_max):
     return 1.0 / (2.0 * math.pi * (1.0 - cos_max))
 
 
-@njit(cache=True, inline="always")
+@device
 def uniform_triangle(u1, u2):
     """Barycentrics (b1, b2) uniform over a triangle (Heitz's low-distortion map)."""
     if u2 > u1:
@@ -150,7 +150,7 @@ def uniform_triangle(u1, u2):
     return b1, b2
 
 
-@njit(cache=True, inline="always")
+@device
 def orthonormal_basis(nx, ny, nz):
     """Two unit vectors t, b with (t, b, n) right-handed (Duff et al. 2017)."""
     sign = 1.0 if nz >= 0.0 else -1.0
@@ -161,7 +161,7 @@ def orthonormal_basis(nx, ny, nz):
     return tx, ty, tz, bx, by, bz
 
 
-@njit(cache=True, inline="always")
+@device
 def power_heuristic(pdf_a, pdf_b):
     """MIS weight of strategy a against b (Veach's power heuristic, beta = 2)."""
     if pdf_a <= 0.0:
@@ -221,7 +221,7 @@ def filter_table(filter_type: str, width: float, size: int = FILTER_TABLE_SIZE) 
     return table
 
 
-@njit(cache=True, inline="always")
+@device
 def filter_offset(table, u):
     """Raster offset from the pixel corner for u in [0, 1), interpolated in ``table``."""
     x = u * (table.shape[0] - 1)

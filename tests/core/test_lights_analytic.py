@@ -1,0 +1,183 @@
+"""Every light type against closed-form irradiance, in Cycles' units.
+
+The receiver is a white Lambert plane (albedo 1) seen from above by an
+orthographic camera covering 2 cm around the origin; its radiance is E / pi.
+Expected values are derived from the light's definition (cycles-conventions.md
+section 1) and, where the reference quotes a Cycles measurement, match it.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from mcengine.scene import Geometry, Light, Material
+
+from .expect import assert_mean, render
+from .scenes import grid_plane, plane_scene, rotation_x, translation
+
+P = 1000.0   # watts
+H = 2.0      # light height above the plane
+
+
+def lambert(irradiance):
+    return irradiance / math.pi
+
+
+def test_point_light_radius_zero_is_inverse_square():
+    li = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P, P, P), radius=0.0)
+    s = render(plane_scene(li))
+    # Cycles measured 6.33159 for this set-up; closed form P/(4 pi^2 d^2) = 6.33257.
+    assert_mean(s, lambert(P / (4 * math.pi * H * H)))
+
+
+def test_point_light_sphere_has_inverse_square_irradiance():
+    # A uniform sphere light gives E = P / (4 pi d^2) outside it, whatever its radius.
+    li = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P, P, P), radius=1.0,
+               soft_falloff=False)
+    s = render(plane_scene(li, samples=256))
+    assert_mean(s, lambert(P / (4 * math.pi * H * H)))
+
+
+def test_point_light_soft_falloff_is_a_facing_disk():
+    li = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P, P, P), radius=1.0,
+               soft_falloff=True)
+    s = render(plane_scene(li, samples=256))
+    assert_mean(s, lambert(P / (4 * math.pi * (H * H + 1.0))))   # Cycles: 5.06606
+
+
+def test_point_light_seen_directly_has_sphere_radiance():
+    # Camera looking up at a visible sphere light: radiance P / (4 pi^2 r^2).
+    r = 0.5
+    li = Light(type="POINT", matrix_world=translation(0, 0, 10), strength=(P, P, P), radius=r,
+               soft_falloff=False, visible_camera=True)
+    scene = plane_scene(li, samples=4)
+    scene.geometry = Geometry()
+    scene.camera.matrix_world = rotation_x(math.pi)   # looks up +Z
+    scene.camera.ortho_scale = 0.1
+    s = render(scene)
+    assert_mean(s, P / (4 * math.pi ** 2 * r * r))        # Cycles: 101.3212
+
+
+@pytest.mark.parametrize("size,blend,angle_deg", [(math.radians(60), 0.0, 20.0),
+                                                  (math.radians(60), 0.0, 40.0),
+                                                  (math.radians(90), 0.5, 35.0)])
+def test_spot_light_cone_and_blend(size, blend, angle_deg):
+    # The receiver point sits at angle a off the spot axis (the spot points down).
+    a = math.radians(angle_deg)
+    x = H * math.tan(a)
+    li = Light(type="SPOT", matrix_world=translation(-x, 0, H), strength=(P, P, P), radius=0.0,
+               spot_size=size, spot_blend=blend)
+    s = render(plane_scene(li, size=0.002))
+    c = math.cos(size / 2)
+    t = (math.cos(a) - c) / ((1 - c) * blend) if blend > 0 else (1.0 if math.cos(a) > c else 0.0)
+    att = min(max(t, 0.0), 1.0)
+    att = att * att * (3 - 2 * att) if blend > 0 else att
+    d2 = H * H + x * x
+    expected = lambert(P / (4 * math.pi * d2) * (H / math.sqrt(d2)) * att)
+    if expected == 0.0:
+        assert s.image()[..., :3].max() == 0.0
+    else:
+        assert_mean(s, expected, deterministic_tol=1e-3)
+
+
+def test_spot_light_on_axis_equals_point_light():
+    li = Light(type="SPOT", matrix_world=translation(0, 0, H), strength=(P, P, P), radius=0.0,
+               spot_size=math.radians(30), spot_blend=0.2)
+    assert_mean(render(plane_scene(li)), lambert(P / (4 * math.pi * H * H)))
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 10.0])
+@pytest.mark.parametrize("tilt_deg", [0.0, 60.0])
+def test_sun_irradiance_is_strength_times_cosine(angle_deg, tilt_deg):
+    S = 3.0
+    li = Light(type="SUN", matrix_world=rotation_x(math.radians(tilt_deg)), strength=(S, S, S),
+               angle=math.radians(angle_deg))
+    s = render(plane_scene(li, samples=256))
+    # Cycles: 0.95493 = 3/pi at angle 0 and 10 deg; 0.47746 tilted 60 deg.
+    assert_mean(s, lambert(S * math.cos(math.radians(tilt_deg))))
+
+
+def _area_irradiance(size_x, size_y, ellipse, power, normalize=True, n=1500):
+    """On-axis irradiance at distance H from a downward area light, by midpoint quadrature."""
+    u = (np.arange(n) + 0.5) / n - 0.5
+    x, y = np.meshgrid(u * size_x, u * size_y)
+    inside = (4 * x * x / size_x ** 2 + 4 * y * y / size_y ** 2 <= 1.0) if ellipse else np.ones_like(x, bool)
+    area = size_x * size_y * (math.pi / 4 if ellipse else 1.0)
+    L = power / (math.pi * (area if normalize else 1.0))
+    d2 = x * x + y * y + H * H
+    dA = size_x * size_y / n / n
+    return float(np.sum(inside * L * (H * H) / (d2 * d2)) * dA)
+
+
+@pytest.mark.parametrize("shape,sx,sy,cycles", [("SQUARE", 1.0, 1.0, 2.33887),
+                                                ("RECTANGLE", 2.0, 0.5, 2.16661),
+                                                ("DISK", 1.0, 1.0, 2.38409),
+                                                ("ELLIPSE", 2.0, 0.5, 2.24817)])
+def test_area_light_shapes(shape, sx, sy, cycles):
+    li = Light(type="AREA", matrix_world=translation(0, 0, H), strength=(100.0,) * 3, shape=shape,
+               size_x=sx, size_y=sy)
+    expected = lambert(_area_irradiance(sx, sy, shape in ("DISK", "ELLIPSE"), 100.0))
+    assert expected == pytest.approx(cycles, rel=2e-4)   # the reference's Cycles measurement
+    assert_mean(render(plane_scene(li, samples=256)), expected)
+
+
+def test_area_light_is_one_sided():
+    # Pointing up (rotated 180 deg about X), the light sends nothing down.
+    li = Light(type="AREA", matrix_world=translation(0, 0, H) @ rotation_x(math.pi),
+               strength=(100.0,) * 3, size_x=1.0)
+    s = render(plane_scene(li))
+    assert s.image()[..., :3].max() == 0.0
+
+
+def test_area_light_object_scale_and_normalize():
+    m = translation(0, 0, H) @ np.diag([2.0, 0.5, 1.0, 1.0])
+    li = Light(type="AREA", matrix_world=m, strength=(100.0,) * 3, shape="SQUARE", size_x=1.0)
+    assert_mean(render(plane_scene(li, samples=256)), lambert(_area_irradiance(2.0, 0.5, False, 100.0)))
+    li = Light(type="AREA", matrix_world=translation(0, 0, H), strength=(100.0,) * 3,
+               shape="SQUARE", size_x=2.0, normalize=False)
+    assert_mean(render(plane_scene(li, samples=256)),
+                lambert(_area_irradiance(2.0, 2.0, False, 100.0, normalize=False)))
+
+
+def test_area_light_spread_keeps_flux():
+    # Narrow spread (30 deg): on axis the radiance is boosted by tan(s/2)/(tan(s/2) - s/2).
+    s_half = math.radians(15)
+    li = Light(type="AREA", matrix_world=translation(0, 0, H), strength=(100.0,) * 3,
+               shape="DISK", size_x=0.05, spread=2 * s_half)
+    n = 400
+    r = (np.arange(n) + 0.5) / n * 0.025
+    theta = np.arctan(r / H)
+    factor = np.maximum(math.tan(s_half) - np.tan(theta), 0) / (math.tan(s_half) - s_half)
+    L = 100.0 / (math.pi * math.pi * 0.025 ** 2)
+    E = float(np.sum(L * factor * H * H / (r * r + H * H) ** 2 * 2 * math.pi * r) * (0.025 / n))
+    # A 2 mm receiver patch: the spread factor changes fast across the plane.
+    assert_mean(render(plane_scene(li, samples=256, size=0.002)), lambert(E))
+
+
+@pytest.mark.parametrize("facing", ["down", "up"])
+def test_emissive_mesh_is_two_sided(facing):
+    # A 1 m emissive square 2 m above the plane, emission colour x strength = 5.
+    quad = grid_plane(1.0, z=H)
+    if facing == "down":
+        quad = quad[:, ::-1]
+    # The camera hangs between the plane and the emitter, looking down.
+    scene = plane_scene(Light(strength=(0.0,) * 3), samples=64, cam_height=1.0)
+    geo = Geometry.concatenate([
+        scene.geometry,
+        Geometry.from_triangles(quad, material_index=np.ones(len(quad), np.int32))])
+    scene.geometry = geo
+    scene.lights = []
+    scene.materials = [Material(base_color=(1, 1, 1)), Material(base_color=(0, 0, 0), emission=(5, 5, 5))]
+    # Same quadrature as an area light of radiance 5 (power 5 * pi * A).
+    expected = lambert(_area_irradiance(1.0, 1.0, False, 5.0 * math.pi))
+    assert_mean(render(scene), expected)
+
+
+def test_world_colour_lights_a_plane():
+    scene = plane_scene(Light(strength=(0.0,) * 3), world=(0.2, 0.4, 0.6), samples=16, albedo=0.5)
+    scene.lights = []
+    s = render(scene)
+    for c, w in enumerate((0.2, 0.4, 0.6)):
+        # Under a uniform sky of radiance w, E = pi w; every cosine-sampled BSDF
+        # ray escapes, so each sample is exactly 0.5 w (up to float32 rounding).
+        assert_mean(s, 0.5 * w, channel=c, deterministic_tol=1e-6)

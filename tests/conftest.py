@@ -1,0 +1,8 @@
+"""Suite-wide pytest settings: markers only (fixtures live next to their tests)."""
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        "slow: takes minutes (e.g. builds and installs the Blender extension); "
+        "part of the full suite, deselect with -m 'not slow'")

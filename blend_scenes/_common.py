@@ -1,0 +1,414 @@
+"""Shared helpers for the scene generator scripts in ``blend_scenes/``.
+
+Each ``blend_scenes/<name>.py`` builds one test or demo scene from Blender's
+factory settings with ``bpy`` and writes ``blend_scenes/<name>.blend`` next to
+itself.  The scenes are the common ground on which Cycles and MC Engine are
+compared, so every scene gets the same unbiased render settings
+(:func:`apply_render_settings`): 128x128 pixels, 64 samples, seed 0, no
+denoising, no adaptive sampling, no clamping, no Filter Glossy, Blackman-Harris
+1.5 px pixel filter, exposure 1, view transform 'Standard', opaque film.
+
+Conventions (Blender's): +Z is up, lengths in metres, colours linear in the
+scene's working space (Linear Rec.709), angles in radians.  Cameras and lights
+are aimed with :func:`look_at`, which points the object's local -Z axis (the
+direction cameras look and area, spot and sun lights shine) at a target.
+
+Materials are restricted to what both engines treat identically:
+
+* :func:`diffuse_material`: Diffuse BSDF with roughness 0 (Lambert).
+* :func:`lambert_principled_material`: Principled BSDF with 'Specular IOR
+  Level' 0, which is exactly Lambert too (it exercises the Principled path).
+* :func:`emission_material`: Emission shader, radiance = colour x strength.
+
+Determinism: the same script writes the same bytes.  :func:`save_blend` lets
+Blender write the file uncompressed, rewrites the few fields Blender fills from
+the clock or leftover memory (see ``_blendfile.py``) and compresses the result
+with zstd itself (Blender reads plain zstd files).  Meshes drop their
+edit-mode selection attributes, which Blender writes with uninitialised bytes.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+
+import bpy
+import zstandard
+
+import _blendfile
+from mathutils import Euler, Vector
+
+# Render settings shared by every scene (see the module docstring).
+RESOLUTION = 128
+SAMPLES = 64
+FILTER_WIDTH_PX = 1.5  # Cycles' default Blackman-Harris width.
+
+# UV sphere tessellation.  Smooth-shaded low-poly meshes are avoided on purpose:
+# Cycles' shadow-terminator handling of interpolated normals differs from a
+# plain renderer's, and 64x32 makes that difference invisible.
+SPHERE_SEGMENTS = 64
+SPHERE_RINGS = 32
+
+# zstd level for the saved files: the files are tiny, so the slowest, densest
+# level costs well under a second.
+ZSTD_LEVEL = 19
+
+# --------------------------------------------------------------------------
+# Scene and render settings
+# --------------------------------------------------------------------------
+
+def new_scene():
+    """Reset Blender to factory settings with an empty scene and return it.
+
+    The scene gets the common render settings (with the default light-scene
+    bounce limits; call :func:`set_bounces` to change them).
+    """
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    apply_render_settings(scene)
+    return scene
+
+
+def apply_render_settings(scene):
+    """Apply the unbiased render settings shared by all scenes (see module docstring)."""
+    scene.render.engine = "CYCLES"
+    scene.render.resolution_x = RESOLUTION
+    scene.render.resolution_y = RESOLUTION
+    scene.render.resolution_percentage = 100
+    scene.render.pixel_aspect_x = 1.0
+    scene.render.pixel_aspect_y = 1.0
+    scene.render.film_transparent = False
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+
+    cycles = scene.cycles
+    cycles.device = "CPU"
+    cycles.samples = SAMPLES
+    cycles.seed = 0
+    cycles.use_animated_seed = False
+    cycles.use_denoising = False
+    cycles.use_adaptive_sampling = False
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.blur_glossy = 0.0
+    cycles.caustics_reflective = True
+    cycles.caustics_refractive = True
+    cycles.pixel_filter_type = "BLACKMAN_HARRIS"
+    cycles.filter_width = FILTER_WIDTH_PX
+    cycles.film_exposure = 1.0
+    set_bounces(scene, total=4, diffuse=4)
+
+
+def set_bounces(scene, total, diffuse, glossy=4, transmission=12):
+    """Set the bounce limits explicitly.
+
+    Cycles stops a path at whichever limit is reached first, the total or the
+    per-type one, so every limit is written rather than left to the defaults
+    (whose glossy 4 / transmission 12 are the default arguments here).
+    """
+    cycles = scene.cycles
+    cycles.max_bounces = total
+    cycles.diffuse_bounces = diffuse
+    cycles.glossy_bounces = glossy
+    cycles.transmission_bounces = transmission
+    cycles.volume_bounces = 0
+    cycles.transparent_max_bounces = 8
+
+
+def set_world(scene, color, strength=1.0):
+    """Give the scene a constant world: Background node, radiance = color x strength."""
+    world = bpy.data.worlds.new("World")
+    tree = world.node_tree
+    tree.nodes.clear()
+    background = tree.nodes.new("ShaderNodeBackground")
+    background.inputs["Color"].default_value = (*color, 1.0)
+    background.inputs["Strength"].default_value = strength
+    output = tree.nodes.new("ShaderNodeOutputWorld")
+    output.location = (300, 0)
+    tree.links.new(background.outputs["Background"], output.inputs["Surface"])
+    scene.world = world
+    return world
+
+
+# --------------------------------------------------------------------------
+# Materials
+# --------------------------------------------------------------------------
+
+def _new_material(name):
+    """A material with an empty node tree plus a Material Output node."""
+    material = bpy.data.materials.new(name)
+    tree = material.node_tree
+    tree.nodes.clear()
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 0)
+    return material, tree, output
+
+
+def diffuse_material(name, color):
+    """Diffuse BSDF with roughness 0 (Lambert, albedo ``color``)."""
+    material, tree, output = _new_material(name)
+    node = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    node.inputs["Color"].default_value = (*color, 1.0)
+    node.inputs["Roughness"].default_value = 0.0
+    tree.links.new(node.outputs["BSDF"], output.inputs["Surface"])
+    material.diffuse_color = (*color, 1.0)  # viewport colour only
+    return material
+
+
+def lambert_principled_material(name, color):
+    """Principled BSDF reduced to exact Lambert: 'Specular IOR Level' 0, no other lobes."""
+    material, tree, output = _new_material(name)
+    node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    node.inputs["Base Color"].default_value = (*color, 1.0)
+    node.inputs["Specular IOR Level"].default_value = 0.0
+    node.inputs["Diffuse Roughness"].default_value = 0.0
+    node.inputs["Metallic"].default_value = 0.0
+    node.inputs["Transmission Weight"].default_value = 0.0
+    node.inputs["Coat Weight"].default_value = 0.0
+    node.inputs["Sheen Weight"].default_value = 0.0
+    node.inputs["Subsurface Weight"].default_value = 0.0
+    node.inputs["Emission Strength"].default_value = 0.0
+    tree.links.new(node.outputs["BSDF"], output.inputs["Surface"])
+    material.diffuse_color = (*color, 1.0)
+    return material
+
+
+def emission_material(name, color, strength):
+    """Emission shader: radiance color x strength on both sides (no factor pi)."""
+    material, tree, output = _new_material(name)
+    node = tree.nodes.new("ShaderNodeEmission")
+    node.inputs["Color"].default_value = (*color, 1.0)
+    node.inputs["Strength"].default_value = strength
+    tree.links.new(node.outputs["Emission"], output.inputs["Surface"])
+    material.diffuse_color = (*color, 1.0)
+    return material
+
+
+# --------------------------------------------------------------------------
+# Objects
+# --------------------------------------------------------------------------
+
+def _link(scene, obj, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0),
+          scale=(1.0, 1.0, 1.0)):
+    obj.location = location
+    obj.rotation_euler = Euler(rotation, "XYZ")
+    obj.scale = scale
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def add_mesh(scene, name, vertices, faces, material, smooth=False, **transform):
+    """Add a mesh object from vertex and face lists.
+
+    Parameters
+    ----------
+    vertices : sequence of (3,) float
+        Vertex positions in object space.
+    faces : sequence of sequence of int
+        Polygons as vertex indices, counter-clockwise seen from the front.
+    material : bpy.types.Material
+    smooth : bool
+        Smooth (vertex-normal) shading; flat otherwise.
+    transform : location, rotation (XYZ Euler, radians), scale
+    """
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in vertices], [], [tuple(f) for f in faces])
+    mesh.validate()
+    _finish_mesh(mesh, material, smooth)
+    return _link(scene, bpy.data.objects.new(name, mesh), **transform)
+
+
+def _finish_mesh(mesh, material, smooth):
+    # Edit-mode selection is meaningless here and is saved with garbage bytes.
+    for name in [a.name for a in mesh.attributes if a.name.startswith(".select_")]:
+        mesh.attributes.remove(mesh.attributes[name])
+    if smooth:
+        mesh.shade_smooth()
+    else:
+        mesh.shade_flat()
+    mesh.materials.append(material)
+    mesh.update()
+
+
+def add_quad(scene, name, corners, material, **transform):
+    """Add one flat quad; ``corners`` (4, 3) counter-clockwise seen from the front."""
+    return add_mesh(scene, name, corners, [(0, 1, 2, 3)], material, **transform)
+
+
+def add_box(scene, name, size, material, **transform):
+    """Add a flat-shaded box with its base centred on the object origin.
+
+    ``size`` is (x, y, z) in metres; the box spans z = 0 .. size_z in object
+    space, so ``location`` is the centre of its bottom face.
+    """
+    sx, sy, sz = (0.5 * size[0], 0.5 * size[1], float(size[2]))
+    vertices = [(-sx, -sy, 0.0), (sx, -sy, 0.0), (sx, sy, 0.0), (-sx, sy, 0.0),
+                (-sx, -sy, sz), (sx, -sy, sz), (sx, sy, sz), (-sx, sy, sz)]
+    faces = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4),
+             (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    return add_mesh(scene, name, vertices, faces, material, **transform)
+
+
+def add_uv_sphere(scene, name, radius, material, smooth=True,
+                  segments=SPHERE_SEGMENTS, rings=SPHERE_RINGS, **transform):
+    """Add a UV sphere centred on the object origin (64x32, smooth by default).
+
+    Same layout as Blender's UV sphere: poles on the Z axis, ``rings`` bands
+    of ``segments`` faces, triangle fans at the poles and quads between.
+    Built vertex by vertex (bmesh's primitive merges seam vertices in an
+    order that varies between runs).
+    """
+    vertices = [(0.0, 0.0, radius)]
+    for ring in range(1, rings):
+        theta = math.pi * ring / rings
+        for segment in range(segments):
+            phi = 2.0 * math.pi * segment / segments
+            vertices.append((radius * math.sin(theta) * math.cos(phi),
+                             radius * math.sin(theta) * math.sin(phi),
+                             radius * math.cos(theta)))
+    bottom = len(vertices)
+    vertices.append((0.0, 0.0, -radius))
+
+    def ring_vertex(ring, segment):
+        return 1 + (ring - 1) * segments + segment % segments
+
+    faces = []  # counter-clockwise seen from outside
+    for segment in range(segments):
+        faces.append((0, ring_vertex(1, segment), ring_vertex(1, segment + 1)))
+        for ring in range(1, rings - 1):
+            faces.append((ring_vertex(ring, segment), ring_vertex(ring + 1, segment),
+                          ring_vertex(ring + 1, segment + 1), ring_vertex(ring, segment + 1)))
+        faces.append((ring_vertex(rings - 1, segment), bottom,
+                      ring_vertex(rings - 1, segment + 1)))
+    return add_mesh(scene, name, vertices, faces, material, smooth=smooth, **transform)
+
+
+def look_at(obj, target):
+    """Rotate ``obj`` so that its local -Z axis points at ``target`` (+Y stays up)."""
+    direction = Vector(target) - Vector(obj.location)
+    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler("XYZ")
+
+
+def add_camera(scene, location, target, lens_mm=50.0):
+    """Add a perspective camera aimed at ``target`` and make it the scene camera."""
+    data = bpy.data.cameras.new("Camera")
+    data.lens = lens_mm
+    data.sensor_width = 36.0
+    data.sensor_fit = "AUTO"
+    data.clip_start = 0.1
+    data.clip_end = 100.0
+    obj = _link(scene, bpy.data.objects.new("Camera", data), location=location)
+    look_at(obj, target)
+    scene.camera = obj
+    return obj
+
+
+def add_light(scene, name, light_type, energy, location, target=None,
+              color=(1.0, 1.0, 1.0), visible_camera=False, rotation=None,
+              scale=(1.0, 1.0, 1.0), **settings):
+    """Add a lamp.
+
+    Parameters
+    ----------
+    light_type : {'POINT', 'SPOT', 'SUN', 'AREA'}
+    energy : float
+        Watts (point, spot, area) or W/m^2 irradiance (sun).
+    target : (3,) float, optional
+        Aim the light's local -Z axis at this point.
+    rotation : (3,) float, optional
+        XYZ Euler angles in radians; used when ``target`` is None.
+    visible_camera : bool
+        Camera-ray visibility (Blender 5.0 creates lights invisible to the camera).
+    settings
+        Further ``bpy.types.Light`` attributes, e.g. ``shadow_soft_size``,
+        ``spot_size``, ``shape``, ``size``.
+    """
+    data = bpy.data.lights.new(name, light_type)
+    data.energy = energy
+    data.color = color
+    for key, value in settings.items():
+        setattr(data, key, value)
+    obj = _link(scene, bpy.data.objects.new(name, data), location=location,
+                rotation=rotation or (0.0, 0.0, 0.0), scale=scale)
+    if target is not None:
+        look_at(obj, target)
+    obj.visible_camera = visible_camera
+    return obj
+
+
+# --------------------------------------------------------------------------
+# The stage shared by the light scenes
+# --------------------------------------------------------------------------
+
+# Floor half-size: large enough that the camera of add_stage sees floor only.
+STAGE_FLOOR_HALF_SIZE = 12.0
+STAGE_CAMERA_LOCATION = (0.0, -5.2, 4.4)
+STAGE_CAMERA_TARGET = (0.0, 0.2, 0.35)
+
+
+def add_stage(scene):
+    """Floor, a rotated cube, a smooth sphere, a small box and the camera.
+
+    The floor is a 24 m square of grey Diffuse BSDF at z = 0, large enough to
+    fill the frame.  The cube uses the Lambert Principled material, the sphere
+    and the small box use Diffuse BSDF.  Returns a dict of the objects.
+    """
+    h = STAGE_FLOOR_HALF_SIZE
+    floor = add_quad(scene, "Floor", [(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)],
+                     diffuse_material("Floor", (0.6, 0.6, 0.6)))
+    cube = add_box(scene, "Cube", (1.0, 1.0, 1.0),
+                   lambert_principled_material("Cube", (0.2, 0.35, 0.7)),
+                   location=(-1.0, 0.4, 0.0), rotation=(0.0, 0.0, math.radians(30.0)))
+    sphere = add_uv_sphere(scene, "Sphere", 0.6, diffuse_material("Sphere", (0.8, 0.8, 0.8)),
+                           location=(0.9, 0.0, 0.6))
+    block = add_box(scene, "Block", (0.5, 0.5, 0.3), diffuse_material("Block", (0.7, 0.3, 0.15)),
+                    location=(0.1, -1.3, 0.0), rotation=(0.0, 0.0, math.radians(-20.0)))
+    camera = add_camera(scene, STAGE_CAMERA_LOCATION, STAGE_CAMERA_TARGET)
+    return {"floor": floor, "cube": cube, "sphere": sphere, "block": block, "camera": camera}
+
+
+# --------------------------------------------------------------------------
+# Saving
+# --------------------------------------------------------------------------
+
+def output_path(script_file):
+    """The .blend path next to a generator script: ``<dir>/<name>.blend``."""
+    return Path(script_file).resolve().with_suffix(".blend")
+
+
+def save_blend(path):
+    """Save the current file byte-for-byte reproducibly, zstd-compressed.
+
+    Blender writes the file uncompressed to a temporary path, which is
+    normalised by :func:`_blendfile.normalize` and compressed into ``path``.
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp), compress=False, relative_remap=False,
+                                copy=True)
+    try:
+        raw = bytearray(tmp.read_bytes())
+    finally:
+        os.remove(tmp)
+    _blendfile.normalize(raw, bpy.data.colorspace.working_space, mark_compressed=True)
+    # The frame carries its uncompressed size; single-threaded compression
+    # (the default) keeps the output identical across machines.
+    compressed = zstandard.ZstdCompressor(level=ZSTD_LEVEL).compress(bytes(raw))
+    path.write_bytes(compressed)
+    print(f"wrote {path} ({len(compressed)} bytes)")
+
+
+def run(build, script_file):
+    """Build a scene with ``build(scene)`` and save it next to ``script_file``."""
+    scene = new_scene()
+    build(scene)
+    bpy.context.view_layer.update()
+    save_blend(output_path(script_file))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit("_common.py is a helper module; run one of the scene scripts instead")

@@ -1,0 +1,45 @@
+"""Regenerate every scene: run each ``blend_scenes/<name>.py`` in its own process.
+
+Usage: /work/venv/bin/python blend_scenes/make_all.py [NAME ...]
+
+Each generator resets Blender to factory settings, but a fresh interpreter per
+scene also keeps add-on and module state from leaking between scenes.  Without
+arguments all scenes in :data:`SCENES` are built; exits non-zero on the first
+failure.
+"""
+import subprocess
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+SCENES = (
+    "cornell_box",
+    "light_point",
+    "light_point_sphere",
+    "light_spot",
+    "light_sun",
+    "light_area",
+    "light_emissive_mesh",
+    "world_color",
+)
+
+
+def main(names):
+    unknown = [n for n in names if n not in SCENES]
+    if unknown:
+        print(f"error: unknown scene(s) {', '.join(unknown)}; choose from {', '.join(SCENES)}",
+              file=sys.stderr)
+        return 2
+    for name in names or SCENES:
+        result = subprocess.run([sys.executable, str(HERE / f"{name}.py")],
+                                capture_output=True, text=True)
+        if result.returncode != 0:
+            print(result.stdout + result.stderr, file=sys.stderr)
+            print(f"error: {name}.py failed with exit code {result.returncode}", file=sys.stderr)
+            return 1
+        print(f"{name}.blend")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

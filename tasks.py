@@ -7,8 +7,9 @@
 Needs only Python 3.11 (bpy 5.0.1, Blender 5.0 as a module, exists for 3.11 only)
 and the standard library.  The first run creates ``.venv`` in the repository and
 installs the project into it (``pip install -e .[test]``, which downloads bpy);
-later runs skip the install unless pyproject.toml or setup.py changed (their hash,
-with the repository's path, is kept in ``.venv/mcengine-install.sha256``).
+later runs skip the install unless pyproject.toml, setup.py or the set of packages
+changed (a hash of them and the repository's path is kept in
+``.venv/mcengine-install.sha256``).
 The job then runs with the venv's Python; the exit status is the job's.
 
 Numba's on-disk JIT cache (``cache=True``) lives next to the sources in this
@@ -32,6 +33,9 @@ VENV_PYTHON = VENV / "bin" / "python"
 INSTALL_STAMP = VENV / "mcengine-install.sha256"
 # Files whose change means the installed environment may be out of date.
 INSTALL_INPUTS = ("pyproject.toml", "setup.py")
+# The editable install records which folders are packages; adding or removing an
+# __init__.py under these needs a reinstall.
+PACKAGE_ROOTS = ("mcengine", "addon")
 REQUIRED_PYTHON = (3, 11)
 
 DEMO_SCENE = REPO / "blend_scenes" / "cornell_box.blend"
@@ -65,11 +69,15 @@ def venv_python_version() -> tuple[int, int] | None:
 
 
 def install_hash() -> str:
+    """Hash of what the installed environment depends on (see INSTALL_INPUTS, PACKAGE_ROOTS)."""
     digest = hashlib.sha256(str(REPO).encode())
     for name in INSTALL_INPUTS:
         path = REPO / name
         digest.update(name.encode())
         digest.update(path.read_bytes() if path.exists() else b"")
+    for root in PACKAGE_ROOTS:
+        for init in sorted((REPO / root).rglob("__init__.py")):
+            digest.update(str(init.relative_to(REPO)).encode())
     return digest.hexdigest()
 
 

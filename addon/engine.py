@@ -1,0 +1,191 @@
+"""The MC Engine render engine: F12 in Blender renders with mcengine.
+
+``render(depsgraph)`` exports the evaluated scene to a
+:class:`mcengine.scene.SceneDescription`, creates a render session and shows
+every progressive pass in the Render Result, with progress and statistics in
+the status bar.  Esc stops the render between passes (the session polls
+``test_break``) and keeps the partial image.
+
+Errors never escape as tracebacks: an invalid scene or any failure becomes
+one ERROR report (and ``error_set``); unsupported features become one WARNING
+report each.  Images from the core are top row first; Blender's render
+passes are bottom row first, so rows are flipped when written.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+import bpy
+import numpy as np
+from mcengine.scene import SceneError
+
+from . import export
+
+__all__ = ["ENGINE_ID", "MCEngine", "session_factory", "register", "unregister"]
+
+ENGINE_ID = "MCENGINE"
+log = logging.getLogger(__name__)
+
+
+def default_session_factory(scene):
+    """Create the core's render session (imported lazily: it loads numba kernels)."""
+    from mcengine.render import RenderSession
+    return RenderSession(scene)
+
+
+#: Callable ``SceneDescription -> session``; tests replace it with a fake session.
+session_factory = default_session_factory
+
+
+class MCEngine(bpy.types.RenderEngine):
+    """Final renders with mcengine (no viewport or preview rendering yet)."""
+
+    bl_idname = ENGINE_ID
+    bl_label = "MC Engine"
+    # False: keep Cycles' shader nodes and material panels, which the exporter reads.
+    bl_use_shading_nodes_custom = False
+    # Material Preview viewport shading uses EEVEE, as for Cycles.
+    bl_use_eevee_viewport = True
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+
+    def render(self, depsgraph):
+        if self.is_preview:
+            return  # bl_use_preview is False; nothing to draw for material previews
+        desc, session = self._prepare(depsgraph)
+        if session is None:
+            return
+        x0, y0, x1, y1 = desc.film.window
+        result = self.begin_result(0, 0, x1 - x0, y1 - y0)
+        progress = _Progress(desc.integrator.samples, desc.integrator.time_limit)
+        try:
+            session.run(on_pass=lambda s: self._publish(result, s, progress),
+                        should_stop=self._stop_requested)
+        except Exception as exc:
+            self._fail(_describe(exc, "rendering"), exc)
+        finally:
+            try:
+                self._write_pixels(result, session)  # the final (or partial) image
+            except Exception as exc:
+                self._fail(_describe(exc, "reading the image"), exc)
+            self.end_result(result)
+
+    # -- steps ---------------------------------------------------------------
+    def _prepare(self, depsgraph):
+        """Export and create the session: (scene description, session), or (None, None)
+        after reporting an error."""
+        self.update_stats("", "Exporting scene")
+        start = time.perf_counter()
+        try:
+            exported = export.export(depsgraph)
+        except Exception as exc:
+            self._fail(_describe(exc, "exporting the scene"), exc)
+            return None, None
+        seconds = time.perf_counter() - start
+        log.info("scene exported in %.3f s", seconds)
+        for warning in exported.scene.warnings:
+            self.report({"WARNING"}, warning)
+        _store_effects(depsgraph.scene.original, exported)
+        self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer")
+        try:
+            session = session_factory(exported.scene)
+        except Exception as exc:
+            self._fail(_describe(exc, "preparing the renderer"), exc)
+            return None, None
+        return exported.scene, session
+
+    def _publish(self, result, session, progress) -> None:
+        """After each pass: show the image, the progress and the statistics."""
+        self._write_pixels(result, session)
+        done = int(session.samples_done)
+        self.update_progress(progress.fraction(done))
+        self.update_stats("", stats_line(done, progress.samples, getattr(session, "stats", None)))
+
+    def _write_pixels(self, result, session) -> None:
+        """Copy ``session.image()`` (top row first) into the Combined pass (bottom row first)."""
+        image = np.asarray(session.image(), np.float32)
+        width, height = result.resolution_x, result.resolution_y
+        if image.shape != (height, width, 4):
+            raise SceneError(f"the renderer returned an image of shape {image.shape} for a "
+                             f"{width}x{height} render region")
+        rect = np.ascontiguousarray(image[::-1]).reshape(-1)
+        result.layers[0].passes["Combined"].rect.foreach_set(rect)
+        self.update_result(result)
+
+    def _stop_requested(self) -> bool:
+        """Polled by the session: True once the user pressed Esc."""
+        return self.test_break()
+
+    def _fail(self, message: str, exc: Exception) -> None:
+        log.debug("MC Engine error", exc_info=exc)
+        self.report({"ERROR"}, f"MC Engine: {message}")
+        self.error_set(f"MC Engine: {message}")
+
+
+class _Progress:
+    """Render progress: samples done over samples, or elapsed over the time limit if later."""
+
+    def __init__(self, samples: int, time_limit: float):
+        self.samples = max(int(samples), 1)
+        self.time_limit = float(time_limit)
+        self.start = time.perf_counter()
+
+    def fraction(self, samples_done: int) -> float:
+        fraction = samples_done / self.samples
+        if self.time_limit > 0:
+            fraction = max(fraction, (time.perf_counter() - self.start) / self.time_limit)
+        return min(fraction, 1.0)
+
+
+def stats_line(done: int, total: int, stats) -> str:
+    """Status-bar text, e.g. "Sample 12/64 | 3.1 Mrays/s | Remaining 00:04".
+
+    Parts ``stats`` lacks (no ``rays_per_second`` or ``eta_seconds``, or a value
+    that is not finite yet) are left out.
+    """
+    parts = [f"Sample {done}/{total}"]
+    rate = getattr(stats, "rays_per_second", None)
+    if rate is not None and math.isfinite(rate) and rate > 0:
+        parts.append(f"{rate / 1e6:.1f} Mrays/s")
+    eta = getattr(stats, "eta_seconds", None)
+    if eta is not None and math.isfinite(eta):
+        parts.append(f"Remaining {_clock(eta)}")
+    return " | ".join(parts)
+
+
+def _clock(seconds: float) -> str:
+    minutes, secs = divmod(int(round(max(seconds, 0.0))), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:02d}:{secs:02d}"
+
+
+def _describe(exc: Exception, doing: str) -> str:
+    """One line for the user: scene errors as they are, anything else with its type."""
+    if isinstance(exc, SceneError):
+        return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return f"failed while {doing}: {type(exc).__name__}: {exc}".splitlines()[0]
+
+
+def _store_effects(scene, exported) -> None:
+    """Remember what the render used for the MC Engine panel.
+
+    Written as ID properties rather than through RNA: the render may run off the
+    main thread, and RNA updates would send notifiers from it.
+    """
+    settings = getattr(scene, "mcengine", None)
+    if settings is not None:
+        settings["last_effects"] = exported.effects()
+        settings["last_ignored"] = ", ".join(exported.ignored)
+
+
+def register() -> None:
+    if not MCEngine.is_registered:
+        bpy.utils.register_class(MCEngine)
+
+
+def unregister() -> None:
+    if MCEngine.is_registered:
+        bpy.utils.unregister_class(MCEngine)

@@ -1,0 +1,103 @@
+"""The scene camera -> :class:`mcengine.scene.Camera`, render settings -> :class:`~mcengine.scene.Film`.
+
+Camera: perspective and orthographic cameras (panoramic ones raise
+:class:`ExportError`).  The world matrix is the evaluated camera's with the
+object scale removed (Cycles ignores camera scale), translation in metres;
+clip distances and the orthographic scale are converted to metres too.
+
+Film: the frame is ``resolution x percentage / 100`` pixels (integer division,
+as Blender does).  With ``render.use_border`` the rendered region is Blender's
+border rectangle, computed exactly as Blender rounds it (float32 fraction x
+size, truncated), then flipped from Blender's bottom-left origin to the
+core's top-left one.  Blender always expects a RenderResult of the border's
+size, whether ``use_crop_to_border`` is on or off (it pastes the region into a
+full frame itself when cropping is off).
+"""
+from __future__ import annotations
+
+import numpy as np
+from mcengine.scene import Camera, Film
+
+from . import ExportError
+from .settings import cycles_settings
+
+__all__ = ["export_camera", "export_film", "frame_size", "border_region"]
+
+
+def export_camera(ctx, depsgraph) -> Camera:
+    """The active scene camera, evaluated."""
+    scene = depsgraph.scene
+    if scene.camera is None:
+        raise ExportError("the scene has no active camera")
+    ob = scene.camera.evaluated_get(depsgraph)
+    cam = ob.data
+    if cam.type not in ("PERSP", "ORTHO"):
+        kind = "panoramic" if cam.type == "PANO" else f"of type {cam.type}"
+        raise ExportError(f"camera '{ob.name}' is {kind}; MC Engine renders perspective and "
+                          f"orthographic cameras only")
+    if cam.dof.use_dof:
+        ctx.warn(f"camera '{ob.name}': depth of field not supported yet; rendered as a pinhole "
+                 f"camera", "depth of field")
+    s = ctx.unit_scale
+    return Camera(
+        matrix_world=_without_scale(np.array(ob.matrix_world, np.float64), s),
+        type=cam.type,
+        lens=float(cam.lens),
+        sensor_width=float(cam.sensor_width),
+        sensor_height=float(cam.sensor_height),
+        sensor_fit=cam.sensor_fit,
+        shift_x=float(cam.shift_x),
+        shift_y=float(cam.shift_y),
+        ortho_scale=float(cam.ortho_scale) * s,
+        clip_start=float(cam.clip_start) * s,
+        clip_end=float(cam.clip_end) * s,
+    )
+
+
+def export_film(ctx, scene) -> Film:
+    """Resolution, border region, pixel filter, transparency and exposure."""
+    render = scene.render
+    width, height = frame_size(render)
+    film = Film(width=width, height=height,
+                pixel_aspect_x=float(render.pixel_aspect_x),
+                pixel_aspect_y=float(render.pixel_aspect_y),
+                region=border_region(render) if render.use_border else None,
+                transparent=bool(render.film_transparent))
+    cycles = cycles_settings(ctx, scene)
+    if cycles is not None:
+        film.filter_type = cycles.pixel_filter_type
+        film.filter_width = float(cycles.filter_width)
+        film.exposure = float(cycles.film_exposure)
+    return film
+
+
+def frame_size(render) -> tuple:
+    """Full frame size in pixels: resolution x percentage / 100, rounded down like Blender."""
+    pct = render.resolution_percentage
+    return render.resolution_x * pct // 100, render.resolution_y * pct // 100
+
+
+def border_region(render) -> tuple:
+    """Blender's border as the core's region ``(x0, y0, x1, y1)``, top-left origin, exclusive.
+
+    Blender computes the border in pixels as ``(int)(float_fraction * size)``
+    (``re_init_resolution`` / ``RE_ReadRenderResult``), with y measured from
+    the bottom of the frame.
+    """
+    width, height = frame_size(render)
+
+    def px(fraction, size):
+        return int(np.float32(fraction) * np.float32(size))
+
+    x0, x1 = px(render.border_min_x, width), px(render.border_max_x, width)
+    y0_up, y1_up = px(render.border_min_y, height), px(render.border_max_y, height)
+    return x0, height - y1_up, x1, height - y0_up
+
+
+def _without_scale(m: np.ndarray, unit_scale: float) -> np.ndarray:
+    """Normalise the rotation columns (drop object scale) and convert the translation to metres."""
+    out = m.copy()
+    lengths = np.linalg.norm(m[:3, :3], axis=0)
+    out[:3, :3] = m[:3, :3] / np.where(lengths > 0, lengths, 1.0)
+    out[:3, 3] = m[:3, 3] * unit_scale
+    return out

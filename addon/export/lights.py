@@ -1,0 +1,115 @@
+"""Blender lamps -> :class:`mcengine.scene.Light`, in Cycles' units.
+
+strength = color x energy x 2**exposure, times ``temperature_color`` when
+``use_temperature`` is on (Blender 5.0 exposes the blackbody colour Cycles
+uses as ``Light.temperature_color``), times the lamp's node tree when it is a
+constant Emission shader (Emission colour x strength; the default is white x 1).
+
+Shadow casting is ``light.use_shadow``; MIS and max bounces come from
+``light.cycles``; the camera/diffuse/glossy/transmission visibility from the
+lamp *object*'s ``visible_*`` flags (that is what Cycles reads).
+
+Units: the matrix translation and the point/spot radius and area sizes are
+converted to metres with the unit scale; the matrix's rotation and object
+scale are kept (the core multiplies area sizes by the object scale, as Cycles
+does).  Power is not rescaled, so with a unit scale other than 1 the lamps
+light the scene 1/scale^2 times as strongly as in Cycles (which ignores the
+unit scale); a warning says so.
+"""
+from __future__ import annotations
+
+import numpy as np
+from mcengine.scene import Light
+
+from .materials import linked_node
+
+__all__ = ["export_light"]
+
+
+def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
+    """Convert one evaluated lamp object (None for lamps that emit nothing: portals).
+
+    Parameters
+    ----------
+    ctx : ExportContext
+    ob : bpy.types.Object
+        Evaluated object of type 'LIGHT'.
+    matrix_world : mathutils.Matrix
+        The instance's world matrix (already copied), in Blender units.
+    name : str
+        Name for messages.
+    """
+    data = ob.data
+    cycles = getattr(data, "cycles", None)
+    if cycles is not None and cycles.is_portal:
+        ctx.warn(f"light '{name}' is a light portal: portals are not supported yet; skipped "
+                 f"(portals add no light, only less noise, in Cycles)", "light portals")
+        return None
+    s = ctx.unit_scale
+    matrix = np.array(matrix_world, np.float64)
+    matrix[:3, 3] *= s
+    light = Light(
+        type=data.type,
+        name=name,
+        matrix_world=matrix,
+        strength=_strength(ctx, data, name),
+        normalize=bool(data.normalize),
+        cast_shadow=bool(data.use_shadow),
+        use_mis=bool(cycles.use_multiple_importance_sampling) if cycles is not None else True,
+        max_bounces=int(cycles.max_bounces) if cycles is not None else 1024,
+        visible_camera=bool(ob.visible_camera),
+        visible_diffuse=bool(ob.visible_diffuse),
+        visible_glossy=bool(ob.visible_glossy),
+        visible_transmission=bool(ob.visible_transmission),
+    )
+    if data.type in ("POINT", "SPOT"):
+        light.radius = float(data.shadow_soft_size) * s
+        light.soft_falloff = bool(data.use_soft_falloff)
+    if data.type == "SPOT":
+        light.spot_size = float(data.spot_size)
+        light.spot_blend = float(data.spot_blend)
+        if data.use_square:
+            ctx.warn(f"light '{name}': square spot cone not supported yet; rendered with a "
+                     f"round cone", "square spot")
+    elif data.type == "SUN":
+        light.angle = float(data.angle)
+    elif data.type == "AREA":
+        light.shape = data.shape
+        light.size_x = float(data.size) * s
+        light.size_y = float(data.size_y if data.shape in ("RECTANGLE", "ELLIPSE") else data.size) * s
+        light.spread = float(data.spread)
+    if s != 1.0 and data.type != "SUN":
+        ctx.warn(f"unit scale {s:g}: lamp power is kept in watts while lengths are converted to "
+                 f"metres, so point, spot and area lamps light {1 / s**2:g}x as strongly as in "
+                 f"Cycles, which ignores the unit scale", "unit scale")
+    return light
+
+
+def _strength(ctx, data, name) -> tuple:
+    """color x energy x 2**exposure (x temperature colour) (x constant node emission)."""
+    rgb = np.array(data.color[:3], np.float64) * data.energy * 2.0 ** data.exposure
+    if data.use_temperature:
+        rgb *= np.array(data.temperature_color[:3], np.float64)
+    rgb *= _node_factor(ctx, data, name)
+    return tuple(float(x) for x in rgb)
+
+
+def _node_factor(ctx, data, name) -> np.ndarray:
+    """Colour factor of the lamp's node tree (ones without one, as Cycles evaluates it)."""
+    tree = data.node_tree if data.use_nodes else None
+    if tree is None:
+        return np.ones(3)
+    out = tree.get_output_node("CYCLES")
+    shader = linked_node(out.inputs["Surface"]) if out is not None else None
+    if shader is None:
+        return np.zeros(3)  # an empty light shader emits nothing in Cycles
+    what = f"{shader.label or shader.name} shader"
+    if shader.bl_idname == "ShaderNodeEmission":
+        color, strength = shader.inputs["Color"], shader.inputs["Strength"]
+        linked = [(linked_node(s), s.name) for s in (color, strength) if linked_node(s) is not None]
+        if not linked:
+            return np.array(color.default_value[:3], np.float64) * strength.default_value
+        what = ", ".join(f"{src.label or src.name} into Emission '{sock}'" for src, sock in linked)
+    ctx.warn(f"light '{name}': light node tree ({what}) not supported yet; rendered without "
+             f"its node tree (Emission strength 1)", "light nodes")
+    return np.ones(3)

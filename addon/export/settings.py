@@ -1,0 +1,96 @@
+"""Render settings shared with Cycles -> :class:`mcengine.scene.Integrator`.
+
+Samples, bounces, clamps, seed and time limit are read from ``scene.cycles``
+(the Cycles add-on's settings) so that one .blend renders with the same
+settings in both engines.  Without the Cycles add-on, the mcengine defaults
+are used and one warning says so.
+"""
+from __future__ import annotations
+
+import numpy as np
+from mcengine.scene import Integrator
+
+__all__ = ["unit_scale", "cycles_settings", "export_integrator", "hash_uint2"]
+
+_MASK32 = 0xFFFFFFFF
+# Cycles hashes (frame_subframe * INT_MAX) as an int when the subframe is non-zero.
+_INT_MAX_F = np.float32(2147483647.0)
+# lookup3's final(a, b, c): each step is "dst ^= src; dst -= rot(src, k)".
+_LOOKUP3_FINAL = (("c", "b", 14), ("a", "c", 11), ("b", "a", 25), ("c", "b", 16),
+                  ("a", "c", 4), ("b", "a", 14), ("c", "b", 24))
+
+
+def unit_scale(scene) -> float:
+    """Metres per Blender unit.
+
+    Blender ignores ``scale_length`` when the unit system is 'NONE'
+    (``BKE_scene_unit_scale``), and so do we.
+    """
+    units = scene.unit_settings
+    return 1.0 if units.system == "NONE" else float(units.scale_length)
+
+
+def cycles_settings(ctx, scene):
+    """``scene.cycles``, or None (plus one warning) if the Cycles add-on is disabled."""
+    cycles = getattr(scene, "cycles", None)
+    if cycles is None:
+        ctx.warn("the Cycles add-on is disabled: MC Engine reads samples, bounces, clamping, "
+                 "seed, time limit and pixel filter from Cycles' settings; using MC Engine "
+                 "defaults instead", "Cycles settings")
+    return cycles
+
+
+def hash_uint2(kx: int, ky: int) -> int:
+    """Cycles' ``hash_uint2`` (Bob Jenkins' lookup3 ``final`` mix) on 32-bit unsigned ints."""
+    def rot(x, k):
+        return ((x << k) | (x >> (32 - k))) & _MASK32
+
+    init = (0xDEADBEEF + (2 << 2) + 13) & _MASK32
+    s = {"a": (init + kx) & _MASK32, "b": (init + ky) & _MASK32, "c": init}
+    for dst, src, k in _LOOKUP3_FINAL:
+        s[dst] = ((s[dst] ^ s[src]) - rot(s[src], k)) & _MASK32
+    return s["c"]
+
+
+def render_seed(cycles, scene) -> int:
+    """The seed Cycles uses: with ``use_animated_seed``, hashed with the frame (and subframe)."""
+    seed = int(cycles.seed)
+    if not cycles.use_animated_seed:
+        return seed
+    hashed = hash_uint2(scene.frame_current & _MASK32, seed & _MASK32)
+    if scene.frame_subframe != 0.0:
+        sub = int(np.float32(scene.frame_subframe) * _INT_MAX_F)
+        hashed = (hashed + hash_uint2(sub & _MASK32, seed & _MASK32)) & _MASK32
+    return hashed
+
+
+def export_integrator(ctx, scene, view_layer) -> Integrator:
+    """Sampling and path settings from ``scene.cycles``; warns about what is not supported."""
+    cycles = cycles_settings(ctx, scene)
+    if cycles is None:
+        return Integrator()
+    samples = int(cycles.samples)
+    if cycles.use_layer_samples == "USE" and view_layer.samples > 0:
+        samples = int(view_layer.samples)  # Cycles' per-view-layer sample override
+    if cycles.use_denoising:
+        ctx.warn("Cycles denoising is enabled for this scene: not supported yet; "
+                 "rendering all samples without denoising", "denoising")
+    if cycles.use_adaptive_sampling:
+        ctx.warn(f"Cycles adaptive sampling is enabled for this scene: not supported yet; "
+                 f"rendering all {samples} samples in every pixel", "adaptive sampling")
+    if scene.render.use_motion_blur:
+        ctx.warn("motion blur is enabled: not supported yet; rendering the frame without it",
+                 "motion blur")
+    return Integrator(
+        samples=samples,
+        seed=render_seed(cycles, scene),
+        max_bounces=int(cycles.max_bounces),
+        diffuse_bounces=int(cycles.diffuse_bounces),
+        glossy_bounces=int(cycles.glossy_bounces),
+        transmission_bounces=int(cycles.transmission_bounces),
+        transparent_max_bounces=int(cycles.transparent_max_bounces),
+        min_light_bounces=int(cycles.min_light_bounces),
+        clamp_direct=float(cycles.sample_clamp_direct),
+        clamp_indirect=float(cycles.sample_clamp_indirect),
+        time_limit=float(cycles.time_limit),
+    )

@@ -1,0 +1,92 @@
+"""User interface: Blender's and Cycles' panels for MC Engine, plus MC Engine's own panel.
+
+A Properties panel is drawn only when ``context.engine`` is in its
+``COMPAT_ENGINES``.  Like Cycles' ``ui.get_panels``, we add our engine id to
+every built-in panel that lists 'BLENDER_RENDER' (camera lens, light and
+material context, output, colour management, ...), except the ones Cycles
+replaces with its own version (listed below).  Cycles' panels (Sampling,
+Light Paths, Film, Light, World, Material, object visibility, ...) share one
+set, ``cycles.ui.CyclesButtonsPanel.COMPAT_ENGINES``; adding our id to it
+shows them all, and they edit ``scene.cycles`` etc., which the engine reads.
+Everything is undone on unregister.
+"""
+from __future__ import annotations
+
+import bpy
+
+from .engine import ENGINE_ID
+
+__all__ = ["MCENGINE_RENDER_PT_engine", "register", "unregister"]
+
+# Built-in panels Cycles replaces by its own (in the shared set); showing both would
+# duplicate them.  Cycles also excludes RENDER_PT_simplify because it has its own
+# (non-shared) simplify panel; we keep Blender's, whose settings act on the depsgraph.
+_REPLACED_BY_CYCLES = {
+    "DATA_PT_camera_dof", "DATA_PT_falloff_curve", "DATA_PT_light", "DATA_PT_preview",
+    "DATA_PT_spot", "MATERIAL_PT_context_material", "MATERIAL_PT_preview", "NODE_DATA_PT_light",
+    "NODE_DATA_PT_spot", "OBJECT_PT_visibility", "VIEWLAYER_PT_filter",
+    "VIEWLAYER_PT_layer_passes", "RENDER_PT_post_processing",
+}
+
+# Panels we added our engine to (so unregister removes it only where we put it).
+_patched: list = []
+
+
+class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
+    """Render Properties > MC Engine: what the last render used and ignored."""
+
+    bl_label = "MC Engine"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context):
+        settings = context.scene.mcengine
+        col = self.layout.column(align=True)
+        if not settings.last_effects:
+            col.label(text="Not rendered yet", icon="INFO")
+            return
+        col.label(text=f"Effects: {settings.last_effects}", icon="SHADING_RENDERED")
+        if settings.last_ignored:
+            col.label(text=f"Ignored: {settings.last_ignored}", icon="ERROR")
+
+
+def compatible_panels() -> list:
+    """Built-in and Cycles panel classes that should also show for MC Engine."""
+    return [p for p in bpy.types.Panel.__subclasses__()
+            if "BLENDER_RENDER" in getattr(p, "COMPAT_ENGINES", ())
+            and p.__name__ not in _REPLACED_BY_CYCLES]
+
+
+def _cycles_panel_base():
+    """``cycles.ui.CyclesButtonsPanel``, or None when the Cycles add-on is not available."""
+    try:
+        from cycles import ui as cycles_ui
+    except ImportError:
+        return None
+    return cycles_ui.CyclesButtonsPanel
+
+
+def register() -> None:
+    if not MCENGINE_RENDER_PT_engine.is_registered:
+        bpy.utils.register_class(MCENGINE_RENDER_PT_engine)
+    targets = compatible_panels()
+    cycles_base = _cycles_panel_base()
+    if cycles_base is not None:
+        targets.append(cycles_base)
+    for panel in targets:
+        if ENGINE_ID not in panel.COMPAT_ENGINES:
+            panel.COMPAT_ENGINES.add(ENGINE_ID)
+            _patched.append(panel)
+
+
+def unregister() -> None:
+    while _patched:
+        _patched.pop().COMPAT_ENGINES.discard(ENGINE_ID)
+    if MCENGINE_RENDER_PT_engine.is_registered:
+        bpy.utils.unregister_class(MCENGINE_RENDER_PT_engine)

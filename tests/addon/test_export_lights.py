@@ -1,0 +1,133 @@
+"""Lamp export: every light type's parameters in Cycles' units."""
+import math
+
+import bpy
+import numpy as np
+import pytest
+from .helpers import export_scene
+
+
+def lamp(scene, kind, name="Lamp", collection=None, **settings):
+    data = bpy.data.lights.new(name, kind)
+    for key, value in settings.items():
+        setattr(data, key, value)
+    ob = bpy.data.objects.new(name, data)
+    (collection or scene.collection).objects.link(ob)
+    return ob
+
+
+def only_light(sessions):
+    desc = export_scene(sessions)
+    assert len(desc.lights) == 1
+    return desc.lights[0], desc.warnings
+
+
+def test_point_light(scene, fake_session):
+    ob = lamp(scene, "POINT", energy=100.0, color=(1, 0.5, 0.25), exposure=1.0,
+              shadow_soft_size=0.3, use_soft_falloff=False, use_shadow=False)
+    ob.data.cycles.use_multiple_importance_sampling = False
+    ob.data.cycles.max_bounces = 7
+    ob.visible_camera, ob.visible_glossy = True, False
+    ob.location = (1, 2, 3)
+    li, _ = only_light(fake_session)
+    assert li.type == "POINT" and li.name == "Lamp"
+    assert li.strength == pytest.approx((200, 100, 50))
+    assert li.radius == pytest.approx(0.3) and li.soft_falloff is False
+    assert (li.cast_shadow, li.use_mis, li.max_bounces) == (False, False, 7)
+    assert (li.visible_camera, li.visible_diffuse, li.visible_glossy, li.visible_transmission) == \
+        (True, True, False, True)
+    np.testing.assert_allclose(li.matrix_world[:3, 3], (1, 2, 3))
+
+
+def test_spot_light(scene, fake_session):
+    ob = lamp(scene, "SPOT", energy=50.0, spot_size=0.8, spot_blend=0.3, shadow_soft_size=0.1)
+    ob.rotation_euler = (0.3, 0.2, 0.1)
+    bpy.context.view_layer.update()
+    li, _ = only_light(fake_session)
+    assert (li.type, li.spot_size, li.spot_blend) == ("SPOT", pytest.approx(0.8), pytest.approx(0.3))
+    assert li.radius == pytest.approx(0.1) and li.soft_falloff is True
+    np.testing.assert_allclose(li.matrix_world, np.array(ob.matrix_world), atol=1e-7)
+
+
+def test_sun_light(scene, fake_session):
+    lamp(scene, "SUN", energy=3.0, angle=math.radians(10))
+    li, _ = only_light(fake_session)
+    assert li.type == "SUN" and li.strength == pytest.approx((3, 3, 3))
+    assert li.angle == pytest.approx(math.radians(10))
+    assert (li.visible_camera, li.cast_shadow, li.use_mis) == (False, True, True)  # 5.0 defaults
+
+
+@pytest.mark.parametrize("shape,size,size_y,expected", [
+    ("RECTANGLE", 2.0, 0.5, (2.0, 0.5)),
+    ("ELLIPSE", 2.0, 0.5, (2.0, 0.5)),
+    ("SQUARE", 1.5, 0.25, (1.5, 1.5)),
+    ("DISK", 1.5, 0.25, (1.5, 1.5)),
+])
+def test_area_light(scene, fake_session, shape, size, size_y, expected):
+    ob = lamp(scene, "AREA", energy=100.0, shape=shape, size=size, size_y=size_y,
+              spread=math.radians(60), normalize=False)
+    ob.scale = (2, 1, 1)
+    li, _ = only_light(fake_session)
+    assert (li.shape, li.size_x, li.size_y) == (shape, *map(pytest.approx, expected))
+    assert li.spread == pytest.approx(math.radians(60)) and li.normalize is False
+    np.testing.assert_allclose(np.linalg.norm(li.matrix_world[:3, :3], axis=0), (2, 1, 1))
+
+
+def test_temperature_colour(scene, fake_session):
+    ob = lamp(scene, "POINT", energy=10.0, color=(1, 1, 0.5), use_temperature=True, temperature=3000)
+    tint = np.array(ob.data.temperature_color)
+    assert not np.allclose(tint, 1)  # a real tint, so the product below is meaningful
+    li, _ = only_light(fake_session)
+    np.testing.assert_allclose(li.strength, 10 * np.array([1, 1, 0.5]) * tint, rtol=1e-6)
+
+
+def test_light_node_tree(scene, fake_session):
+    ob = lamp(scene, "POINT", energy=10.0)
+    ob.data.use_nodes = True
+    emission = ob.data.node_tree.nodes["Emission"]
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((10, 10, 10)) and not any("light node" in w for w in warnings)
+    emission.inputs["Color"].default_value = (0.5, 1, 1, 1)
+    emission.inputs["Strength"].default_value = 2.0
+    li, _ = only_light(fake_session)
+    assert li.strength == pytest.approx((10, 20, 20))
+    blackbody = ob.data.node_tree.nodes.new("ShaderNodeBlackbody")
+    ob.data.node_tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((10, 10, 10))
+    assert "light 'Lamp': light node tree (Blackbody into Emission 'Color') not supported yet; " \
+           "rendered without its node tree (Emission strength 1)" in warnings
+
+
+def test_portals_are_skipped_with_a_warning(scene, fake_session):
+    lamp(scene, "AREA", name="Window").data.cycles.is_portal = True
+    desc = export_scene(fake_session)
+    assert desc.lights == []
+    assert any(w.startswith("light 'Window' is a light portal") for w in desc.warnings)
+
+
+def test_instanced_lights(scene, fake_session):
+    col = bpy.data.collections.new("Lamps")
+    lamp(scene, "POINT", name="Bulb", collection=col)
+    for x in (0, 4):
+        empty = bpy.data.objects.new(f"Fixture{x}", None)
+        empty.instance_type, empty.instance_collection = "COLLECTION", col
+        empty.location = (x, 0, 0)
+        scene.collection.objects.link(empty)
+    desc = export_scene(fake_session)
+    assert sorted(li.matrix_world[0, 3] for li in desc.lights) == [0, 4]
+    assert sorted(li.name for li in desc.lights) == ["Fixture0/Bulb", "Fixture4/Bulb"]
+
+
+def test_unit_scale_converts_lengths_not_power(scene, fake_session):
+    scene.unit_settings.scale_length = 0.01
+    lamp(scene, "POINT", name="Bulb", energy=100.0, shadow_soft_size=10.0).location = (100, 0, 0)
+    lamp(scene, "AREA", name="Panel", energy=100.0, shape="RECTANGLE", size=50.0, size_y=20.0)
+    desc = export_scene(fake_session)
+    bulb, panel = sorted(desc.lights, key=lambda li: li.name)
+    assert bulb.radius == pytest.approx(0.1) and bulb.matrix_world[0, 3] == pytest.approx(1.0)
+    assert (panel.size_x, panel.size_y) == (pytest.approx(0.5), pytest.approx(0.2))
+    assert bulb.strength == pytest.approx((100, 100, 100)) == panel.strength
+    assert [w for w in desc.warnings if w.startswith("unit scale")] == [
+        "unit scale 0.01: lamp power is kept in watts while lengths are converted to metres, so "
+        "point, spot and area lamps light 10000x as strongly as in Cycles, which ignores the unit scale"]

@@ -1,0 +1,272 @@
+"""Mesh export: world-space triangles, normals, UVs, instancing, materials per triangle."""
+import math
+
+import bpy
+import numpy as np
+import pytest
+from .helpers import CUBE_FACES, CUBE_VERTS, export_scene, new_mesh_object
+
+TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+
+
+def corners(geometry):
+    """(T, 3, 3) world positions of the triangle corners."""
+    return geometry.vertices[geometry.triangles].astype(np.float64)
+
+
+def geometric_normals(geometry):
+    p = corners(geometry)
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def test_triangle_with_known_transform(scene, fake_session):
+    ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])
+    ob.location = (1, 2, 3)
+    ob.rotation_euler = (0, 0, math.pi / 2)
+    ob.scale = (2, 2, 2)
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 1
+    np.testing.assert_allclose(corners(g)[0], [(1, 2, 3), (1, 4, 3), (-1, 2, 3)], atol=1e-6)
+    np.testing.assert_allclose(g.normals[0], [(0, 0, 1)] * 3, atol=1e-6)
+    np.testing.assert_array_equal(g.uvs, np.zeros((1, 3, 2)))
+    assert g.material_index.tolist() == [0]
+    assert g.object_names == ["Tri"]
+
+
+def _check_closed_cube(g, center):
+    """Outward geometric normals that agree with the flat shading normals."""
+    p = corners(g)
+    ng = geometric_normals(g)
+    outward = np.einsum("ti,ti->t", ng, p.mean(axis=1) - center)
+    assert np.all(outward > 0), "some triangles face inwards"
+    shading = g.normals.astype(np.float64)
+    for k in range(3):
+        np.testing.assert_allclose(shading[:, k], ng, atol=1e-5)
+
+
+@pytest.mark.parametrize("scale", [(1, 2, 3), (-1, 2, 3), (-1, -1, -1)])
+def test_cube_positions_winding_and_normals(scene, fake_session, scale):
+    ob = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)
+    ob.location = (0.5, -1, -5)
+    ob.rotation_euler = (0.5, 0, 0.8)
+    ob.scale = scale
+    bpy.context.view_layer.update()
+    m = np.array(ob.matrix_world)
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 12
+    expected = {tuple(np.round(m[:3, :3] @ v + m[:3, 3], 5)) for v in CUBE_VERTS}
+    assert {tuple(np.round(v, 5)) for v in g.vertices.astype(np.float64)} == expected
+    _check_closed_cube(g, m[:3, 3])
+    # the faces keep their areas: 2x2 local squares spanned by the scaled axes
+    a = np.linalg.norm(m[:3, :3], axis=0) * 2
+    area = np.linalg.norm(np.cross(corners(g)[:, 1] - corners(g)[:, 0],
+                                   corners(g)[:, 2] - corners(g)[:, 0]), axis=1).sum() / 2
+    assert area == pytest.approx(2 * (a[0] * a[1] + a[1] * a[2] + a[0] * a[2]), rel=1e-5)
+
+
+def test_normals_use_the_inverse_transpose(scene, fake_session):
+    """A slanted face under non-uniform scale: the normal stays perpendicular to the face."""
+    ob = new_mesh_object("Slant", [(0, 0, 0), (1, 0, 0), (0, 1, 1)], [(0, 1, 2)])
+    ob.scale = (1, 1, 3)
+    g = export_scene(fake_session).geometry
+    np.testing.assert_allclose(g.normals[0, 0], geometric_normals(g)[0], atol=1e-6)
+    np.testing.assert_allclose(g.normals[0, 0], np.array([0, -3, 1]) / math.sqrt(10), atol=1e-6)
+
+
+def test_smooth_shading_normals(scene, fake_session):
+    """A symmetric roof, shaded smooth: the ridge normal is straight up, the eaves keep the face normals."""
+    verts = [(-1, -1, 0), (-1, 1, 0), (0, 1, 1), (0, -1, 1), (1, -1, 0), (1, 1, 0)]
+    ob = new_mesh_object("Roof", verts, [(0, 3, 2, 1), (3, 4, 5, 2)])
+    ob.data.shade_smooth()
+    g = export_scene(fake_session).geometry
+    p = corners(g)
+    n = g.normals.astype(np.float64)
+    ridge = np.isclose(p[..., 2], 1)
+    np.testing.assert_allclose(n[ridge], np.tile([0, 0, 1], (ridge.sum(), 1)), atol=1e-6)
+    left = ~ridge & (p[..., 0] < 0)
+    np.testing.assert_allclose(n[left], np.tile(np.array([-1, 0, 1]) / math.sqrt(2), (left.sum(), 1)),
+                               atol=1e-6)
+
+
+@pytest.mark.parametrize("shading,domain", [("flat", "FACE"), ("smooth", "POINT"),
+                                            ("sharp edges", "CORNER")])
+def test_shading_normals_equal_blender_corner_normals(scene, fake_session, shading, domain):
+    ob = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)
+    me = ob.data
+    if shading != "flat":
+        me.shade_smooth()
+    if shading == "sharp edges":  # the edges around one face: its corners get the face normal
+        for edge in me.edges:
+            edge.use_edge_sharp = set(edge.vertices).issubset(me.polygons[0].vertices)
+    assert me.normals_domain == domain
+    loops = np.empty(len(me.loop_triangles) * 3, np.int32)
+    me.loop_triangles.foreach_get("loops", loops)
+    corner = np.empty(len(me.loops) * 3, np.float32)
+    me.corner_normals.foreach_get("vector", corner)
+    g = export_scene(fake_session).geometry
+    np.testing.assert_allclose(g.normals.reshape(-1, 3), corner.reshape(-1, 3)[loops], atol=1e-6)
+
+
+def test_uvs_come_from_the_active_render_uv_map(scene, fake_session):
+    ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])
+    first, second = ob.data.uv_layers.new(name="First"), ob.data.uv_layers.new(name="Second")
+    first.uv.foreach_set("vector", [0.0] * 6)
+    second.uv.foreach_set("vector", [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    second.active_render = True
+    g = export_scene(fake_session).geometry
+    np.testing.assert_allclose(g.uvs[0], [(0.1, 0.2), (0.3, 0.4), (0.5, 0.6)], atol=1e-7)
+
+
+def test_modifiers_are_applied(scene, fake_session):
+    ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])
+    array = ob.modifiers.new("Array", "ARRAY")
+    array.count = 3  # relative offset 1 along x: the triangle is 1 wide
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 3
+    assert sorted(corners(g)[:, :, 0].min(axis=1).round(6).tolist()) == [0, 1, 2]
+
+
+def test_objects_hidden_from_render_are_skipped(scene, fake_session):
+    new_mesh_object("Shown", TRI, [(0, 1, 2)])
+    hidden = new_mesh_object("Hidden", CUBE_VERTS, CUBE_FACES)
+    hidden.hide_render = True
+    g = export_scene(fake_session).geometry
+    assert g.object_names == ["Shown"] and g.num_triangles == 1
+
+
+@pytest.fixture
+def count_mesh_reads(addon, monkeypatch):
+    calls = []
+    real = addon.export.mesh.read_local_mesh
+
+    def counting(ob, slots):
+        calls.append(ob.name)
+        return real(ob, slots)
+
+    monkeypatch.setattr(addon.export.mesh, "read_local_mesh", counting)
+    return calls
+
+
+def test_collection_instances_are_expanded_and_read_once(scene, fake_session, count_mesh_reads):
+    col = bpy.data.collections.new("Assets")  # not linked to the scene: only its instances render
+    new_mesh_object("Tri", TRI, [(0, 1, 2)], collection=col)
+    for i, x in enumerate((0, 10, 20)):
+        empty = bpy.data.objects.new(f"Inst{i}", None)
+        empty.instance_type, empty.instance_collection = "COLLECTION", col
+        empty.location = (x, 0, 0)
+        scene.collection.objects.link(empty)
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 3
+    assert sorted(corners(g)[:, 0, 0].round(6).tolist()) == [0, 10, 20]
+    assert sorted(g.object_names) == ["Inst0/Tri", "Inst1/Tri", "Inst2/Tri"]
+    assert count_mesh_reads == ["Tri"]
+
+
+def test_vertex_instancing(scene, fake_session):
+    parent = new_mesh_object("Dots", [(0, 0, 5), (3, 0, 5)], [])
+    parent.instance_type = "VERTS"
+    child = new_mesh_object("Tri", TRI, [(0, 1, 2)])
+    child.parent = parent
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 2
+    assert sorted(map(tuple, corners(g)[:, 0].round(6))) == [(0, 0, 5), (3, 0, 5)]
+
+
+def _instance_on_points_group(count):
+    ng = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    ng.interface.new_socket(name="Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    ng.interface.new_socket(name="Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    ng.nodes.new("NodeGroupInput")
+    out = ng.nodes.new("NodeGroupOutput")
+    line = ng.nodes.new("GeometryNodeMeshLine")  # points at z = 0, 1, 2, ...
+    line.inputs["Count"].default_value = count
+    cube = ng.nodes.new("GeometryNodeMeshCube")  # 1 m cube centred on its point
+    iop = ng.nodes.new("GeometryNodeInstanceOnPoints")
+    ng.links.new(line.outputs["Mesh"], iop.inputs["Points"])
+    ng.links.new(cube.outputs["Mesh"], iop.inputs["Instance"])
+    ng.links.new(iop.outputs["Instances"], out.inputs["Geometry"])
+    return ng
+
+
+def test_geometry_nodes_instances_are_expanded_and_read_once(scene, fake_session, count_mesh_reads):
+    ob = new_mesh_object("Scatter", [], [])
+    ob.modifiers.new("GN", "NODES").node_group = _instance_on_points_group(3)
+    ob.location = (1, 0, 0)
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 3 * 12
+    centers = [corners(g)[g.object_index == i].reshape(-1, 3).mean(axis=0) for i in range(3)]
+    assert sorted(map(tuple, np.round(centers, 5))) == [(1, 0, 0), (1, 0, 1), (1, 0, 2)]
+    assert len(count_mesh_reads) == 2  # the holder's own (empty) mesh, then the cube once
+
+
+def test_multi_material_mesh_and_material_table(scene, fake_session):
+    red, green = bpy.data.materials.new("Red"), bpy.data.materials.new("Green")
+    verts = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (2, 0, 0), (3, 0, 0), (2, 1, 0), (4, 0, 0), (5, 0, 0), (4, 1, 0)]
+    ob = new_mesh_object("Multi", verts, [(0, 1, 2), (3, 4, 5), (6, 7, 8)], materials=[red, green])
+    ob.data.materials.append(None)  # an empty third slot
+    ob.data.polygons.foreach_set("material_index", [1, 0, 2])
+    other = new_mesh_object("Other", TRI, [(0, 1, 2)], materials=[green])
+    other.location = (0, 5, 0)
+    new_mesh_object("Bare", TRI, [(0, 1, 2)]).location = (0, 9, 0)
+    desc = export_scene(fake_session)
+    names = [m.name for m in desc.materials]
+    assert sorted(names) == ["Green", "Red", "default surface"]  # de-duplicated
+    g = desc.geometry
+    per_tri = {}
+    for t in range(g.num_triangles):
+        key = (g.object_names[g.object_index[t]], round(float(corners(g)[t, 0, 0])))
+        per_tri[key] = names[g.material_index[t]]
+    assert per_tri == {("Multi", 0): "Green", ("Multi", 2): "Red", ("Multi", 4): "default surface",
+                       ("Other", 0): "Green", ("Bare", 0): "default surface"}
+    assert desc.materials[names.index("default surface")].base_color == (0.8, 0.8, 0.8)
+
+
+def test_unit_scale_converts_positions_to_metres(scene, fake_session):
+    scene.unit_settings.scale_length = 0.01
+    ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])
+    ob.location = (100, 200, 300)
+    scene.camera.data.clip_start, scene.camera.data.clip_end = 10, 5000
+    desc = export_scene(fake_session)
+    np.testing.assert_allclose(corners(desc.geometry)[0], [(1, 2, 3), (1.01, 2, 3), (1, 2.01, 3)], atol=1e-6)
+    assert (desc.camera.clip_start, desc.camera.clip_end) == pytest.approx((0.1, 50))
+    scene.unit_settings.system = "NONE"  # Blender ignores scale_length without a unit system
+    np.testing.assert_allclose(corners(export_scene(fake_session).geometry)[0, 0], (100, 200, 300))
+
+
+def test_curves_and_text_are_exported_once(scene, fake_session):
+    curve = bpy.data.curves.new("Ring", "CURVE")
+    curve.dimensions, curve.extrude = "3D", 0.2
+    spline = curve.splines.new("POLY")
+    spline.points.add(3)
+    spline.points.foreach_set("co", [0, 0, 0, 1, 1, 0, 0, 1, 1, 1, 0, 1, 0, 1, 0, 1])
+    spline.use_cyclic_u = True
+    scene.collection.objects.link(bpy.data.objects.new("Ring", curve))
+    g = export_scene(fake_session).geometry
+    assert g.num_triangles == 8  # 4 extruded edges, 2 triangles each: not doubled
+
+
+def test_one_failing_object_is_skipped_with_a_warning(scene, fake_session, addon, monkeypatch):
+    new_mesh_object("Good", TRI, [(0, 1, 2)])
+    new_mesh_object("Bad", TRI, [(0, 1, 2)]).location = (5, 0, 0)
+    real = addon.export.mesh.read_local_mesh
+
+    def failing(ob, slots):
+        if ob.name == "Bad":
+            raise ValueError("broken mesh")
+        return real(ob, slots)
+
+    monkeypatch.setattr(addon.export.mesh, "read_local_mesh", failing)
+    desc = export_scene(fake_session)
+    assert desc.geometry.object_names == ["Good"]
+    assert "object 'Bad' skipped: ValueError: broken mesh" in desc.warnings
+
+
+def test_hair_and_visibility_settings_are_named_once(scene, fake_session):
+    for i in range(7):
+        ob = new_mesh_object(f"Ghost{i}", TRI, [(0, 1, 2)])
+        ob.visible_camera = False
+    desc = export_scene(fake_session)
+    notes = [w for w in desc.warnings if "ray visibility" in w]
+    assert notes == ["ray visibility not supported yet ('Ghost0', 'Ghost1', 'Ghost2', 'Ghost3', "
+                     "'Ghost4' and 2 more); these objects are visible to all rays"]

@@ -1,0 +1,135 @@
+"""Integrator settings read from scene.cycles, and the world background."""
+import addon_utils
+import bpy
+import pytest
+from .helpers import export_scene
+
+DENOISE = "Cycles denoising is enabled for this scene: not supported yet; rendering all samples without denoising"
+
+
+def test_integrator_reads_cycles_settings(scene, fake_session):
+    c = scene.cycles
+    c.samples, c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 37, 9, 3, 2
+    c.transmission_bounces, c.transparent_max_bounces, c.min_light_bounces = 5, 6, 1
+    c.sample_clamp_direct, c.sample_clamp_indirect, c.time_limit, c.seed = 4.0, 2.5, 30.0, 11
+    c.use_denoising = c.use_adaptive_sampling = False
+    desc = export_scene(fake_session)
+    i = desc.integrator
+    assert (i.samples, i.max_bounces, i.diffuse_bounces, i.glossy_bounces) == (37, 9, 3, 2)
+    assert (i.transmission_bounces, i.transparent_max_bounces, i.min_light_bounces) == (5, 6, 1)
+    assert (i.clamp_direct, i.clamp_indirect, i.time_limit, i.seed) == (4.0, 2.5, 30.0, 11)
+    assert desc.warnings == []
+
+
+def test_view_layer_samples_override(scene, fake_session):
+    scene.cycles.samples = 64
+    bpy.context.view_layer.samples = 5
+    assert export_scene(fake_session).integrator.samples == 5
+    scene.cycles.use_layer_samples = "IGNORE"
+    assert export_scene(fake_session).integrator.samples == 64
+
+
+def _lookup3_hash_uint2(kx, ky):
+    """Cycles' hash_uint2, written out statement by statement as in util/hash.h."""
+    m = 0xFFFFFFFF
+
+    def rot(x, k):
+        return ((x << k) | (x >> (32 - k))) & m
+
+    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & m
+    b = (b + ky) & m
+    a = (a + kx) & m
+    c ^= b
+    c = (c - rot(b, 14)) & m
+    a ^= c
+    a = (a - rot(c, 11)) & m
+    b ^= a
+    b = (b - rot(a, 25)) & m
+    c ^= b
+    c = (c - rot(b, 16)) & m
+    a ^= c
+    a = (a - rot(c, 4)) & m
+    b ^= a
+    b = (b - rot(a, 14)) & m
+    c ^= b
+    c = (c - rot(b, 24)) & m
+    return c
+
+
+def test_animated_seed_is_hashed_with_the_frame(scene, fake_session, addon):
+    scene.cycles.seed, scene.cycles.use_animated_seed = 3, True
+    seeds = []
+    for frame in (1, 2):
+        scene.frame_set(frame)
+        seeds.append(export_scene(fake_session).integrator.seed)
+    assert seeds == [_lookup3_hash_uint2(1, 3), _lookup3_hash_uint2(2, 3)]
+    assert seeds[0] != seeds[1]
+    for kx, ky in ((0, 0), (0xFFFFFFFF, 7), (12345, 0x80000000)):
+        assert addon.export.settings.hash_uint2(kx, ky) == _lookup3_hash_uint2(kx, ky)
+
+
+def test_unsupported_sampling_features_are_warned(scene, fake_session):
+    scene.cycles.samples = 16
+    scene.render.use_motion_blur = True
+    warnings = export_scene(fake_session).warnings
+    assert warnings == [
+        DENOISE,
+        "Cycles adaptive sampling is enabled for this scene: not supported yet; rendering all 16 "
+        "samples in every pixel",
+        "motion blur is enabled: not supported yet; rendering the frame without it",
+    ]
+    assert scene.mcengine.last_ignored == "denoising, adaptive sampling, motion blur"
+
+
+def test_without_cycles_the_defaults_are_used_with_one_warning(scene, fake_session, addon):
+    from mcengine.scene import Film, Integrator
+
+    addon_utils.disable("cycles")
+    try:
+        assert not hasattr(scene, "cycles")
+        desc = export_scene(fake_session)
+    finally:
+        addon_utils.enable("cycles", default_set=True)
+        addon.register()
+    assert desc.integrator == Integrator()
+    assert (desc.film.filter_type, desc.film.filter_width) == (Film().filter_type, Film().filter_width)
+    assert [w for w in desc.warnings if "Cycles add-on is disabled" in w] == [
+        "the Cycles add-on is disabled: MC Engine reads samples, bounces, clamping, seed, time limit "
+        "and pixel filter from Cycles' settings; using MC Engine defaults instead"]
+
+
+def world_with_background(color, strength):
+    world = bpy.data.worlds.new("Sky")
+    bg = world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (*color, 1)
+    bg.inputs["Strength"].default_value = strength
+    bpy.context.scene.world = world
+    return world
+
+
+def test_world_background(scene, fake_session):
+    world_with_background((0.2, 0.4, 0.6), 2.0)
+    desc = export_scene(fake_session)
+    assert desc.world.color == pytest.approx((0.4, 0.8, 1.2)) and desc.world.visible_camera
+    assert not any(w.startswith("world") for w in desc.warnings)
+
+
+def test_no_world_is_black(scene, fake_session):
+    scene.world = None
+    assert export_scene(fake_session).world.color == (0, 0, 0)
+
+
+def test_world_camera_visibility(scene, fake_session):
+    world_with_background((1, 1, 1), 1.0).cycles_visibility.camera = False
+    assert export_scene(fake_session).world.visible_camera is False
+
+
+def test_world_texture_uses_the_unlinked_value(scene, fake_session):
+    world = world_with_background((0.1, 0.2, 0.3), 1.0)
+    sky = world.node_tree.nodes.new("ShaderNodeTexSky")
+    world.node_tree.links.new(sky.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+    desc = export_scene(fake_session)
+    assert desc.world.color == pytest.approx((0.1, 0.2, 0.3))
+    assert [w for w in desc.warnings if w.startswith("world")] == [
+        "world 'Sky': Sky Texture into 'Color' not supported yet; using the unlinked values, "
+        "background (0.1, 0.2, 0.3)"]

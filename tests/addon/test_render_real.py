@@ -1,0 +1,29 @@
+"""F12 with the real core: a tiny scene whose pixels are known exactly."""
+import bpy
+import numpy as np
+from .helpers import new_mesh_object
+
+
+def test_f12_renders_with_the_real_core(scene, render_exr):
+    """An emitter over the upper half of an orthographic view: every camera sample there sees
+    exactly its radiance (black base colour, no world), the lower half sees nothing."""
+    scene.render.resolution_x, scene.render.resolution_y = 16, 12
+    scene.camera.data.type, scene.camera.data.ortho_scale = "ORTHO", 4.0
+    scene.world = None
+    scene.cycles.samples = 4
+    scene.cycles.use_denoising = scene.cycles.use_adaptive_sampling = False
+    mat = bpy.data.materials.new("Glow")
+    node = mat.node_tree.nodes["Principled BSDF"]
+    node.inputs["Base Color"].default_value = (0, 0, 0, 1)
+    node.inputs["Specular IOR Level"].default_value = 0.0
+    node.inputs["Emission Color"].default_value = (1, 0.5, 0.25, 1)
+    node.inputs["Emission Strength"].default_value = 2.0
+    new_mesh_object("Upper", [(-5, 0, -1), (5, 0, -1), (5, 5, -1), (-5, 5, -1)], [(0, 1, 2, 3)],
+                    materials=[mat])
+    image = render_exr()
+    assert image.shape == (12, 16, 4)
+    # The edge is between rows 5 and 6; the Blackman-Harris filter reaches 1.5 px, so rows
+    # 0-3 and 8-11 cannot see across it.
+    np.testing.assert_allclose(image[:4], np.broadcast_to([2, 1, 0.5, 1], (4, 16, 4)), rtol=1e-6)
+    np.testing.assert_allclose(image[8:], np.broadcast_to([0, 0, 0, 1], (4, 16, 4)), atol=1e-7)
+    assert scene.mcengine.last_effects == "Emission"

@@ -16,7 +16,7 @@ import bpy
 
 from .engine import ENGINE_ID
 
-__all__ = ["MCENGINE_RENDER_PT_engine", "register", "unregister"]
+__all__ = ["MCENGINE_RENDER_PT_engine", "compatible_panels", "register", "unregister"]
 
 # Built-in panels Cycles replaces by its own (in the shared set); showing both would
 # duplicate them.  Cycles also excludes RENDER_PT_simplify because it has its own
@@ -27,9 +27,6 @@ _REPLACED_BY_CYCLES = {
     "NODE_DATA_PT_spot", "OBJECT_PT_visibility", "VIEWLAYER_PT_filter",
     "VIEWLAYER_PT_layer_passes", "RENDER_PT_post_processing",
 }
-
-# Panels we added our engine to (so unregister removes it only where we put it).
-_patched: list = []
 
 
 class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
@@ -58,9 +55,13 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
 
 def compatible_panels() -> list:
     """Built-in and Cycles panel classes that should also show for MC Engine."""
-    return [p for p in bpy.types.Panel.__subclasses__()
-            if "BLENDER_RENDER" in getattr(p, "COMPAT_ENGINES", ())
-            and p.__name__ not in _REPLACED_BY_CYCLES]
+    panels = [p for p in bpy.types.Panel.__subclasses__()
+              if "BLENDER_RENDER" in getattr(p, "COMPAT_ENGINES", ())
+              and p.__name__ not in _REPLACED_BY_CYCLES]
+    cycles_base = _cycles_panel_base()
+    if cycles_base is not None:
+        panels.append(cycles_base)
+    return panels
 
 
 def _cycles_panel_base():
@@ -75,18 +76,12 @@ def _cycles_panel_base():
 def register() -> None:
     if not MCENGINE_RENDER_PT_engine.is_registered:
         bpy.utils.register_class(MCENGINE_RENDER_PT_engine)
-    targets = compatible_panels()
-    cycles_base = _cycles_panel_base()
-    if cycles_base is not None:
-        targets.append(cycles_base)
-    for panel in targets:
-        if ENGINE_ID not in panel.COMPAT_ENGINES:
-            panel.COMPAT_ENGINES.add(ENGINE_ID)
-            _patched.append(panel)
+    for panel in compatible_panels():
+        panel.COMPAT_ENGINES.add(ENGINE_ID)
 
 
 def unregister() -> None:
-    while _patched:
-        _patched.pop().COMPAT_ENGINES.discard(ENGINE_ID)
+    for panel in compatible_panels():
+        panel.COMPAT_ENGINES.discard(ENGINE_ID)
     if MCENGINE_RENDER_PT_engine.is_registered:
         bpy.utils.unregister_class(MCENGINE_RENDER_PT_engine)

@@ -272,7 +272,8 @@ def _shading_normals(me, loops, corner_vertices, polygons):
     ones the face normals, which are the same values at a fraction of the cost.
     """
     if me.normals_domain == "POINT":
-        return _get(me.vertex_normals, "vector", np.float32, len(me.vertices) * 3).reshape(-1, 3)[corner_vertices]
+        vertex = _get(me.vertex_normals, "vector", np.float32, len(me.vertices) * 3).reshape(-1, 3)
+        return vertex[corner_vertices]
     if me.normals_domain == "FACE":
         face = _get(me.polygon_normals, "vector", np.float32, len(me.polygons) * 3).reshape(-1, 3)
         return np.repeat(face[polygons], 3, axis=0)

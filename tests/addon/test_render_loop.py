@@ -1,4 +1,6 @@
 """The render loop (F12) with a fake session: pixels, orientation, progress, Esc, errors."""
+from types import SimpleNamespace
+
 import bpy
 import numpy as np
 import pytest
@@ -67,14 +69,34 @@ def test_border_render_result_size(scene, fake_session, render_exr, crop):
         assert not image[:y0].any() and not image[y1:].any()
 
 
-def test_effects_line_is_stored_on_the_scene(scene, fake_session):
+def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addon):
     mat = bpy.data.materials.new("Glow")
     mat.node_tree.nodes["Principled BSDF"].inputs["Emission Strength"].default_value = 1.0
     new_mesh_object("Tri", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)], materials=[mat])
     scene.collection.objects.link(bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN")))
+    panel_lines = _panel_text(addon, scene)
+    assert panel_lines == ["Not rendered yet"]
     bpy.ops.render.render()
     assert scene.mcengine.last_effects == "Diffuse, Emission, 1 Sun"
     assert scene.mcengine.last_ignored == "specular, denoising, adaptive sampling"
+    assert _panel_text(addon, scene) == ["Effects: Diffuse, Emission, 1 Sun",
+                                         "Ignored: specular, denoising, adaptive sampling"]
+
+
+def _panel_text(addon, scene):
+    """The labels the MC Engine render panel draws (with a recording stand-in layout)."""
+    lines = []
+
+    class Layout:
+        def column(self, **_):
+            return self
+
+        def label(self, text="", **_):
+            lines.append(text)
+
+    panel = SimpleNamespace(layout=Layout())
+    addon.ui.MCENGINE_RENDER_PT_engine.draw(panel, SimpleNamespace(scene=scene))
+    return lines
 
 
 def _render_error(capfd):
@@ -119,8 +141,6 @@ def test_core_failure_while_rendering_reports_one_error(scene, addon, monkeypatc
 
 
 def test_stats_line(addon):
-    from types import SimpleNamespace
-
     line = addon.engine.stats_line
     assert line(12, 64, SimpleNamespace(rays_per_second=3.14e6, eta_seconds=4.4)) == \
         "Sample 12/64 | 3.1 Mrays/s | Remaining 00:04"

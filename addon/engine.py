@@ -29,13 +29,13 @@ ENGINE_ID = "MCENGINE"
 log = logging.getLogger(__name__)
 
 
-def default_session_factory(scene):
+def default_session_factory(scene, threads=None):
     """Create the core's render session (imported lazily: it loads numba kernels)."""
     from mcengine.render import RenderSession
-    return RenderSession(scene)
+    return RenderSession(scene, threads=threads)
 
 
-#: Callable ``SceneDescription -> session``; tests replace it with a fake session.
+#: Callable ``(SceneDescription, threads=None) -> session``; tests replace it with a fake.
 session_factory = default_session_factory
 
 
@@ -90,8 +90,11 @@ class MCEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, warning)
         _store_effects(depsgraph.scene.original, exported)
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer")
+        render = depsgraph.scene.render
+        # Blender's Performance > Threads setting; AUTO leaves the choice to the core.
+        threads = render.threads if render.threads_mode == "FIXED" else None
         try:
-            session = session_factory(exported.scene)
+            session = session_factory(exported.scene, threads=threads)
         except Exception as exc:
             self._fail(_describe(exc, "preparing the renderer"), exc)
             return None, None

@@ -39,8 +39,9 @@ def scene(addon):
 def fake_session(addon, monkeypatch):
     sessions = []
 
-    def factory(desc):
+    def factory(desc, threads=None):
         sessions.append(GradientSession(desc))
+        sessions[-1].threads = threads
         return sessions[-1]
 
     monkeypatch.setattr(addon.engine, "session_factory", factory)

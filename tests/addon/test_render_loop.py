@@ -42,6 +42,13 @@ def test_progressive_updates_show_every_pass(scene, fake_session, published, ren
     assert published[0][0, 7, 0] == 7 / 4  # the first pass is a quarter of the final value
 
 
+def test_fixed_thread_count_reaches_the_session(scene, fake_session):
+    bpy.ops.render.render()
+    scene.render.threads_mode, scene.render.threads = "FIXED", 3
+    bpy.ops.render.render()
+    assert [s.threads for s in fake_session] == [None, 3]
+
+
 def test_stop_after_the_first_pass_keeps_the_partial_image(scene, fake_session, published, addon,
                                                           monkeypatch, render_exr):
     monkeypatch.setattr(addon.engine.MCEngine, "_stop_requested", lambda self: len(published) >= 1)
@@ -117,7 +124,7 @@ def test_invalid_scene_reports_one_error(scene, fake_session, capfd):
 
 
 def test_scene_error_from_the_core_reports_one_error(scene, addon, monkeypatch, capfd):
-    def refuse(desc):
+    def refuse(desc, threads=None):
         raise SceneError("film region (0, 0, 9, 9) is empty or outside the 8x6 frame")
 
     monkeypatch.setattr(addon.engine, "session_factory", refuse)
@@ -134,7 +141,7 @@ def test_core_failure_while_rendering_reports_one_error(scene, addon, monkeypatc
             raise MemoryError("out of memory in pass 2")
 
     sessions = []
-    monkeypatch.setattr(addon.engine, "session_factory", lambda d: sessions.append(Crashing(d)) or sessions[-1])
+    monkeypatch.setattr(addon.engine, "session_factory", lambda d, threads: sessions.append(Crashing(d)) or sessions[-1])
     message = _render_error(capfd)
     assert message.splitlines()[0] == \
         "Error: MC Engine: failed while rendering: MemoryError: out of memory in pass 2"

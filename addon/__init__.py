@@ -9,19 +9,24 @@ reused (see ``ui``).
 Works as the Python package ``mcengine_blender`` and as a Blender extension
 (``bl_ext.<repo>.<id>``): imports inside the add-on are relative; the core is
 ``import mcengine``.  ``register`` and ``unregister`` may be called twice.
+
+Importing this package does not import ``bpy``: the command line
+(``mcengine_blender.cli``) lives here too and must reject bad arguments
+before paying for Blender's start-up.
 """
-from . import engine, properties, ui
 
 __all__ = ["register", "unregister"]
 
 
 def register() -> None:
+    from . import engine, properties, ui
     properties.register()
     engine.register()
     ui.register()
 
 
 def unregister() -> None:
+    from . import engine, properties, ui
     ui.unregister()
     engine.unregister()
     properties.unregister()

@@ -429,6 +429,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             u2 = rand(key, bounce_dim(bounce, DIM_LIGHT_V))
             lr = lg = lb = 0.0
             wix = wiy = wiz = 0.0
+            lnx = lny = lnz = 0.0   # unit normal at the light point (emissive triangles)
             pdf_l = 0.0
             dist = 0.0
             use_mis = True
@@ -462,15 +463,15 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                     fx_ = (e1[1] - e0[1]) * (e2[2] - e0[2]) - (e1[2] - e0[2]) * (e2[1] - e0[1])
                     fy_ = (e1[2] - e0[2]) * (e2[0] - e0[0]) - (e1[0] - e0[0]) * (e2[2] - e0[2])
                     fz_ = (e1[0] - e0[0]) * (e2[1] - e0[1]) - (e1[1] - e0[1]) * (e2[0] - e0[0])
-                    # |cos| at the light: cross product length is twice the area.
-                    cos_l = abs(fx_ * wix + fy_ * wiy + fz_ * wiz) / (2.0 * sc.tri_area[tri])
+                    # |cos| at the light: the cross product's length is twice the area.
+                    lnx, lny, lnz = (fx_ / (2.0 * sc.tri_area[tri]), fy_ / (2.0 * sc.tri_area[tri]),
+                                     fz_ / (2.0 * sc.tri_area[tri]))
+                    cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
                     if cos_l > 0.0:
                         pdf_l = sc.emit_pmf[j] * d2 / (sc.tri_area[tri] * cos_l)
                         em = sc.materials[sc.mat_index[tri]]
                         lr, lg, lb = (em[M_EMISSION] / pdf_l, em[M_EMISSION + 1] / pdf_l,
                                       em[M_EMISSION + 2] / pdf_l)
-                    # The shadow ray must stop before the emitter itself.
-                    dist -= offset_scale(qx, qy, qz)
             if lr + lg + lb > 0.0 and dist > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
                 wlx = wix * tx + wiy * ty + wiz * tz
                 wly = wix * bx + wiy * by + wiz * bz
@@ -484,13 +485,23 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                     limit = fcfg[FCFG_CLAMP_DIRECT] if nee_direct else fcfg[FCFG_CLAMP_INDIRECT]
                     cr, cg, cb = _clamp(cr, cg, cb, limit, stats)
                     if cast_shadow:
+                        # Both ends leave their surfaces (pbrt's SpawnRayTo): the
+                        # direction is re-aimed from the offset origin at the
+                        # offset target, else at grazing angles the shifted ray
+                        # reaches the emitter's plane before tmax.
                         sox, soy, soz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
-                        if math.isinf(dist):
-                            tmax = T_INFINITE
-                        else:
-                            tmax = dist * (1.0 - SHADOW_SHORTEN)
+                        sdx, sdy, sdz = wix, wiy, wiz
+                        tmax = T_INFINITE
+                        if not math.isinf(dist):
+                            ex, ey, ez = hx + dist * wix, hy + dist * wiy, hz + dist * wiz
+                            if lnx != 0.0 or lny != 0.0 or lnz != 0.0:
+                                ex, ey, ez = offset_origin(ex, ey, ez, lnx, lny, lnz, -wix, -wiy, -wiz)
+                            sdx, sdy, sdz = ex - sox, ey - soy, ez - soz
+                            length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
+                            sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
+                            tmax = length * (1.0 - SHADOW_SHORTEN)
                         sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
-                        sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = wix, wiy, wiz
+                        sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = sdx, sdy, sdz
                         sq.t32[n_shadow] = tmax
                         sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
                         sq.path[n_shadow] = i

@@ -12,9 +12,10 @@ lamp *object*'s ``visible_*`` flags (that is what Cycles reads).
 Units: the matrix translation and the point/spot radius and area sizes are
 converted to metres with the unit scale; the matrix's rotation and object
 scale are kept (the core multiplies area sizes by the object scale, as Cycles
-does).  Power is not rescaled, so with a unit scale other than 1 the lamps
-light the scene 1/scale^2 times as strongly as in Cycles (which ignores the
-unit scale); a warning says so.
+does).  Cycles ignores the unit scale, so to give the same image the power
+of point, spot and area lamps is multiplied by scale^2: irradiance
+(power / distance^2, or radiance x solid angle) is then unchanged.  Sun
+irradiance needs no change.
 """
 from __future__ import annotations
 
@@ -78,10 +79,8 @@ def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
         light.size_x = float(data.size) * s
         light.size_y = float(data.size_y if data.shape in ("RECTANGLE", "ELLIPSE") else data.size) * s
         light.spread = float(data.spread)
-    if s != 1.0 and data.type != "SUN":
-        ctx.warn(f"unit scale {s:g}: lamp power is kept in watts while lengths are converted to "
-                 f"metres, so point, spot and area lamps light {1 / s**2:g}x as strongly as in "
-                 f"Cycles, which ignores the unit scale", "unit scale")
+    if data.type != "SUN":
+        light.strength = tuple(v * s * s for v in light.strength)
     return light
 
 

@@ -119,7 +119,7 @@ def test_instanced_lights(scene, fake_session):
     assert sorted(li.name for li in desc.lights) == ["Fixture0/Bulb", "Fixture4/Bulb"]
 
 
-def test_unit_scale_converts_lengths_not_power(scene, fake_session):
+def test_unit_scale_converts_lengths_and_keeps_irradiance(scene, fake_session):
     scene.unit_settings.scale_length = 0.01
     lamp(scene, "POINT", name="Bulb", energy=100.0, shadow_soft_size=10.0).location = (100, 0, 0)
     lamp(scene, "AREA", name="Panel", energy=100.0, shape="RECTANGLE", size=50.0, size_y=20.0)
@@ -127,7 +127,6 @@ def test_unit_scale_converts_lengths_not_power(scene, fake_session):
     bulb, panel = sorted(desc.lights, key=lambda li: li.name)
     assert bulb.radius == pytest.approx(0.1) and bulb.matrix_world[0, 3] == pytest.approx(1.0)
     assert (panel.size_x, panel.size_y) == (pytest.approx(0.5), pytest.approx(0.2))
-    assert bulb.strength == pytest.approx((100, 100, 100)) == panel.strength
-    assert [w for w in desc.warnings if w.startswith("unit scale")] == [
-        "unit scale 0.01: lamp power is kept in watts while lengths are converted to metres, so "
-        "point, spot and area lamps light 10000x as strongly as in Cycles, which ignores the unit scale"]
+    # Power x scale^2: the same irradiance as Cycles, which ignores the unit scale.
+    assert bulb.strength == pytest.approx((0.01, 0.01, 0.01)) == panel.strength
+    assert not [w for w in desc.warnings if "unit scale" in w]

@@ -181,3 +181,46 @@ def test_world_colour_lights_a_plane():
         # Under a uniform sky of radiance w, E = pi w; every cosine-sampled BSDF
         # ray escapes, so each sample is exactly 0.5 w (up to float32 rounding).
         assert_mean(s, 0.5 * w, channel=c, deterministic_tol=1e-6)
+
+
+def _tilted_panel():
+    a = math.radians(35)
+    rot = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
+    quad = np.array([[-1, -0.4, 0], [1, -0.4, 0], [1, 0.4, 0], [-1, 0.4, 0]]) @ rot.T + [0.3, 1.3, 1.8]
+    return quad, np.array([[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]])
+
+
+def _panel_irradiance(quad, p, n=800):
+    """Irradiance at floor point p from a two-sided quad of radiance 1 (midpoint rule)."""
+    u = (np.arange(n) + 0.5) / n
+    uu, vv = np.meshgrid(u, u)
+    q = quad[0] + uu[..., None] * (quad[1] - quad[0]) + vv[..., None] * (quad[3] - quad[0])
+    nq = np.cross(quad[1] - quad[0], quad[3] - quad[0])
+    area = np.linalg.norm(nq)
+    d = q - p
+    r2 = (d * d).sum(-1)
+    cos_r = np.maximum(d[..., 2], 0) / np.sqrt(r2)
+    cos_l = np.abs(d @ (nq / area)) / np.sqrt(r2)
+    return float((cos_r * cos_l / r2).sum() * area / n / n)
+
+
+@pytest.mark.parametrize("receiver", [(-0.5, -1.0), (-1.5, 0.0), (0.3, 3.0)])
+def test_emissive_panel_seen_at_grazing_angles(receiver):
+    """A tilted emissive quad lighting floor points from its back side, nearly edge-on.
+
+    At (-0.5, -1.0) the floor point lies 0.15 m behind the panel's plane, so
+    every shadow ray meets the panel at a grazing angle: a shadow ray shifted
+    off the floor but still aimed along the unshifted direction hits the
+    panel's plane before its end and the light is lost.
+    """
+    quad, tris = _tilted_panel()
+    x, y = receiver
+    scene = plane_scene(Light(strength=(0.0,) * 3), samples=1024, size=0.002, cam_height=0.5)
+    scene.camera.matrix_world = translation(x, y, 0.5)
+    scene.lights = []
+    scene.geometry = Geometry.concatenate([
+        Geometry.from_triangles(grid_plane(40.0)),
+        Geometry.from_triangles(tris, material_index=np.ones(2, np.int32))])
+    scene.materials = [Material(base_color=(1, 1, 1)), Material(base_color=(0, 0, 0), emission=(1, 1, 1))]
+    expected = lambert(_panel_irradiance(quad, np.array([x, y, 0.0])))
+    assert_mean(render(scene), expected, max_rel_se=0.003)

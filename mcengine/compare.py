@@ -15,12 +15,17 @@ region by region:
   the K-seed average is that over ``K``.  This pools ``n (K - 1)`` degrees of
   freedom per region, so even ``K = 2`` gives a usable test.
 * A splatting pixel filter or a denoiser correlates neighbouring pixels and
-  would make that variance too small.  Each stack therefore also measures the
-  seed-to-seed variance of its block means directly and compares it with the
-  independent-pixel prediction (the ratio is the *pixel correlation factor*,
-  1 for independent pixels); variances are multiplied by ``max(1, factor)``.
-  Negative correlation (blue-noise sampling) is not credited, which is
-  conservative.
+  would make that variance too small.  Each stack therefore measures the
+  seed-to-seed variance of its block sums directly and compares it with the
+  independent-pixel prediction; for the frame it also sums the residuals'
+  covariance over pixel offsets up to ``MAX_CORRELATION_LAG`` (pairs that
+  block edges cut).  These *pixel correlation factors* are 1 up to noise for
+  independent pixels; variances are multiplied by ``max(1, factor)`` and the
+  factor's own noise lowers the degrees of freedom.  Pooling over the image
+  makes them precise enough for K = 2 (about 10 %).  Negative correlation
+  (blue-noise sampling) is not credited, which is conservative.  A factor
+  well above 1 is named in the summary: renders meant for this test should
+  have denoising off.
 * Regions are the whole frame and an 8x8 grid of blocks (edges from
   ``np.linspace``, so any image size works).  Per region and RGB channel,
   ``t = (mean_a - mean_b) / sqrt(se_a**2 + se_b**2)`` gets a two-sided p-value
@@ -30,6 +35,13 @@ region by region:
   tails instead of an overconfident normal p-value.
 * The family-wise error over all (region, channel) tests is held at ``alpha``
   with Holm-Bonferroni.  The verdict is "differ" if any test is rejected.
+  Regions without noise in either stack and equal to float precision (black
+  areas, say) carry no information and are skipped.
+
+The test is about expected values only: a biased estimator in *both*
+renderers (Cycles' indirect clamp, say) cancels out, and a difference smaller
+than the noise of the stacks goes unseen; the confidence interval on the
+frame's relative bias states how small a difference could have been seen.
 
 Conventions
 -----------
@@ -69,23 +81,39 @@ FLOAT_TOLERANCE_ABS = 1e-8
 # cancelling lgamma terms (1e-8 relative at 1e8 dof).
 DOF_NORMAL = 1e7
 
+# A correlation factor this far above 1 (4 standard deviations of its noise at
+# K = 2) means the renders' pixels are not independent: the summary says so,
+# since a denoiser left on is the usual cause.
+CORRELATION_WARNING = 1.5
+
 # Incomplete-beta continued fraction: relative convergence tolerance (double
 # precision) and a cap on iterations far above the few hundred it needs.
 _CF_TOLERANCE = 1e-15
 _CF_MAX_ITER = 10_000
 _CF_TINY = 1e-300  # stands in for a zero denominator in Lentz's method
 
-# Quantiles are found by bisection on the survival function: 200 halvings of
-# the bracket reach double precision from any starting width.
-_BISECT_ITER = 200
+# Quantiles: Newton steps on the log survival function, doubling or bisection
+# when a step leaves the bracket; 200 steps reach double precision even by
+# bisection alone.
+_ROOT_ITER = 200
 
 
 # ----------------------------------------------------------------------------
 # Distributions and multiple testing
 # ----------------------------------------------------------------------------
 
-_erfc = np.frompyfunc(math.erfc, 1, 1)
-_lgamma = np.frompyfunc(math.lgamma, 1, 1)
+_erfc_obj = np.frompyfunc(math.erfc, 1, 1)
+_lgamma_obj = np.frompyfunc(math.lgamma, 1, 1)
+
+
+def _erfc(x) -> np.ndarray:
+    """Elementwise ``math.erfc`` (numpy has none)."""
+    return np.asarray(_erfc_obj(x), dtype=np.float64)
+
+
+def _lgamma(x) -> np.ndarray:
+    """Elementwise ``math.lgamma``."""
+    return np.asarray(_lgamma_obj(x), dtype=np.float64)
 
 
 def _betainc_cf(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -98,18 +126,19 @@ def _betainc_cf(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     f = np.ones_like(x)
     c = np.ones_like(x)
     d = np.zeros_like(x)
-    for j in range(1, _CF_MAX_ITER + 1):
-        m = j // 2
-        if j % 2:  # odd terms d_{2m+1}
-            coef = -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))
-        else:      # even terms d_{2m}
-            coef = m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m))
-        d = 1.0 + coef * d
-        d = 1.0 / np.where(np.abs(d) > _CF_TINY, d, _CF_TINY)
-        c = 1.0 + coef / c
-        c = np.where(np.abs(c) > _CF_TINY, c, _CF_TINY)
-        delta = c * d
-        f *= delta
+    for m in range(_CF_MAX_ITER):
+        # terms d_{2m} (from m = 1 on) and d_{2m+1}
+        odd = -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))
+        even = m * (b - m) * x / ((a + 2 * m - 1) * (a + 2 * m)) if m else None
+        for coef in (even, odd):
+            if coef is None:
+                continue
+            d = 1.0 + coef * d
+            d = 1.0 / np.where(np.abs(d) > _CF_TINY, d, _CF_TINY)
+            c = 1.0 + coef / c
+            c = np.where(np.abs(c) > _CF_TINY, c, _CF_TINY)
+            delta = c * d
+            f *= delta
         if np.all(np.abs(delta - 1.0) < _CF_TOLERANCE):
             return 1.0 / f
     raise ArithmeticError("incomplete beta continued fraction did not converge")
@@ -123,7 +152,7 @@ def _betainc(x: np.ndarray, x1: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.
     """
     swap = x >= (a + 1.0) / (a + b + 2.0)     # use I_x(a, b) = 1 - I_{1-x}(b, a)
     xs, as_, bs = np.where(swap, x1, x), np.where(swap, b, a), np.where(swap, a, b)
-    lbeta = (_lgamma(a + b) - _lgamma(a) - _lgamma(b)).astype(np.float64)
+    lbeta = _lgamma(a + b) - _lgamma(a) - _lgamma(b)
     with np.errstate(divide="ignore"):
         log_front = a * np.log(x) + b * np.log(x1) + lbeta
     part = np.exp(log_front) * _betainc_cf(xs, as_, bs) / as_
@@ -131,6 +160,7 @@ def _betainc(x: np.ndarray, x1: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.
 
 
 def _scalar_or_array(out: np.ndarray, like: np.ndarray):
+    """``out`` as a float if ``like`` is 0-d (scalar in, scalar out)."""
     return float(out) if like.ndim == 0 else out
 
 
@@ -161,32 +191,49 @@ def student_t_sf(t, dof):
         x1 = 1.0 / (1.0 + dof / (at * at))
     normal = dof > DOF_NORMAL
     half = np.empty_like(at)
-    half[normal] = 0.5 * _erfc(at[normal] / math.sqrt(2.0)).astype(np.float64)
+    half[normal] = 0.5 * _erfc(at[normal] / math.sqrt(2.0))
     n = dof[~normal]
     half[~normal] = 0.5 * _betainc(x[~normal], x1[~normal], 0.5 * n, np.full_like(n, 0.5))
     return _scalar_or_array(np.where(t < 0, 1.0 - half, half), t)
 
 
+def _student_t_pdf(t: np.ndarray, dof: np.ndarray) -> np.ndarray:
+    """Density of Student's t (normal above ``DOF_NORMAL``), same-shape arrays."""
+    normal = dof > DOF_NORMAL
+    nu = np.where(normal, 1.0, dof)           # placeholder where the normal is used
+    log_c = _lgamma(0.5 * (nu + 1)) - _lgamma(0.5 * nu) - 0.5 * np.log(nu * math.pi)
+    student = np.exp(log_c - 0.5 * (nu + 1) * np.log1p(t * t / nu))
+    return np.where(normal, np.exp(-0.5 * t * t) / math.sqrt(2 * math.pi), student)
+
+
 def student_t_isf(p, dof):
     """Inverse of :func:`student_t_sf`: the ``t`` with ``P(T > t) = p``.
 
-    ``dof = inf`` gives the standard normal quantile.  Elementwise bisection,
-    to about 1e-12 relative.
+    ``dof = inf`` gives the standard normal quantile.  Newton's method on
+    ``log P(T > t)``, safeguarded by bisection; as accurate as
+    :func:`student_t_sf` allows (1e-12 relative at moderate ``dof``).
     """
     p, dof = np.broadcast_arrays(np.asarray(p, np.float64), np.asarray(dof, np.float64))
     if not np.all((0.0 < p) & (p < 1.0)):
         raise ValueError("student_t_isf needs 0 < p < 1")
     upper = np.minimum(p, 1.0 - p)          # solve in the upper tail, then mirror
-    lo, hi = np.zeros_like(upper), np.ones_like(upper)
-    while np.any(beyond := student_t_sf(hi, dof) > upper):
-        lo, hi = np.where(beyond, hi, lo), np.where(beyond, 2.0 * hi, hi)
-    for _ in range(_BISECT_ITER):
-        mid = 0.5 * (lo + hi)
-        right = student_t_sf(mid, dof) > upper
-        lo, hi = np.where(right, mid, lo), np.where(right, hi, mid)
-        if np.all(hi - lo <= 1e-12 * hi):
+    # Start at the normal tail bound sqrt(-2 ln p) (above the normal quantile,
+    # below heavy-tailed ones); [lo, hi] brackets the root as it is learned.
+    t = np.sqrt(-2.0 * np.log(upper))
+    lo, hi = np.zeros_like(t), np.full_like(t, np.inf)
+    for _ in range(_ROOT_ITER):
+        sf = student_t_sf(t, dof)
+        left_of_root = sf > upper
+        lo, hi = np.where(left_of_root, t, lo), np.where(left_of_root, hi, t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            newton = t + (np.log(sf) - np.log(upper)) * sf / _student_t_pdf(t, dof)
+        inside = (newton > lo) & (newton < hi)
+        fallback = np.where(np.isinf(hi), 2.0 * t, 0.5 * (lo + hi))
+        t_next = np.where(inside, newton, fallback)
+        done = np.all(np.abs(t_next - t) <= 1e-12 * np.maximum(t_next, 1.0))
+        t = t_next
+        if done:
             break
-    t = 0.5 * (lo + hi)
     return _scalar_or_array(np.where(p > 0.5, -t, t), p)
 
 
@@ -289,8 +336,91 @@ class _RegionMoments:
     noisy: np.ndarray
 
 
+# Pixel correlation at the frame scale is summed over lags up to this many
+# pixels in x and y: a splatted Blackman-Harris filter of width 1.5 px (the
+# Blender default) correlates pixels up to 3 px apart, a Gaussian of width
+# 1.5 px up to 4.5 px.  Longer-range correlation (a denoiser) shows in the
+# block factor instead.
+MAX_CORRELATION_LAG = 4
+
+
+def _block_correlation(seed_block_sums: np.ndarray, total_pixel_var: float):
+    """Measured over independent-pixel variance of the block sums.
+
+    Parameters
+    ----------
+    seed_block_sums : (K, gy, gx, 3) float
+        Block sums of each render.
+    total_pixel_var : float
+        ``sum_p s2_p`` over all pixels and channels: what ``sum_b Var(S_b)``
+        would be for independent pixels.
+
+    Returns
+    -------
+    factor : float
+        ``sum_b Var_k(S_b) / sum_p s2_p``: 1 up to noise (about
+        ``sqrt(2 / (n_blocks * 3 * (K - 1)))``) for independent pixels.
+    dof : float
+        Welch-Satterthwaite degrees of freedom of the numerator, which carries
+        nearly all of the factor's noise (relative variance ``2 / dof``).
+    """
+    k = seed_block_sums.shape[0]
+    v = seed_block_sums.var(axis=0, ddof=1)
+    if total_pixel_var <= 0 or not v.any():
+        return 1.0, math.inf
+    return float(v.sum()) / total_pixel_var, float(v.sum() ** 2 / (v**2).sum() * (k - 1))
+
+
+def _fft_size(n: int) -> int:
+    """Smallest ``2**i 3**j 5**k >= n`` (a size numpy's FFT handles fast)."""
+    best = 2 * n
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            p = p35
+            while p < n:
+                p *= 2
+            best = min(best, p)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
+def _lag_correlation(residuals: np.ndarray, max_lag: int = MAX_CORRELATION_LAG) -> float:
+    """Variance of a large region's sum over its independent-pixel value.
+
+    Parameters
+    ----------
+    residuals : (K, h, w, 3) float
+        Each render minus the stack's per-pixel mean.
+    max_lag : int
+        Largest pixel offset in x and y whose covariance is counted.
+
+    Returns
+    -------
+    float
+        ``1 + sum_{0 < |l| <= max_lag} sum_p e(p) e(p + l) / sum_p e(p)**2``
+        pooled over seeds and channels (pairs inside the image only): 1 up to
+        noise (about ``2 max_lag / sqrt(h w 3 (K - 1))``) for independent
+        pixels.  The lag sums come from one zero-padded FFT autocorrelation.
+    """
+    h, w = residuals.shape[1:3]
+    lag_y, lag_x = min(max_lag, h - 1), min(max_lag, w - 1)
+    size = (_fft_size(h + lag_y), _fft_size(w + lag_x))   # padding: no wrap-around
+    spectrum = np.fft.rfft2(residuals, s=size, axes=(1, 2))
+    acf = np.fft.irfft2((spectrum.real**2 + spectrum.imag**2).sum(axis=(0, 3)), s=size)
+    power = acf[0, 0]
+    if power <= 0:
+        return 1.0
+    # offsets (0, 1..L), (1..L, 0..L) and (1..L, -L..-1): each pair once
+    cross = (acf[0, 1:lag_x + 1].sum() + acf[1:lag_y + 1, :lag_x + 1].sum()
+             + acf[1:lag_y + 1, size[1] - lag_x:].sum())
+    return float(1.0 + 2.0 * cross / power)
+
+
 def _stack_moments(stack: np.ndarray, ey: np.ndarray, ex: np.ndarray):
-    """Frame and block moments of one stack, and its pixel correlation factor.
+    """Frame and block moments of one stack, and its pixel correlation factors.
 
     Parameters
     ----------
@@ -301,38 +431,45 @@ def _stack_moments(stack: np.ndarray, ey: np.ndarray, ex: np.ndarray):
     -------
     frame : _RegionMoments with (3,) arrays
     blocks : _RegionMoments with (gy, gx, 3) arrays
-    correlation : float
-        ``sum_b Var_k(block mean) / sum_b (sum_p s2_p / n_b**2)`` over blocks
-        and channels: 1 for independent pixels, larger when a filter or
-        denoiser correlates them.
+    correlation : (2,) float
+        :func:`_block_correlation` and :func:`_lag_correlation`.  Block
+        variances are multiplied by ``max(1, block)``, frame variances by
+        ``max(1, block, lag)``: the lag factor also counts the pairs that
+        block edges cut.
     """
     k = stack.shape[0]
     pixel_mean = stack.mean(axis=0)
     pixel_var = stack.var(axis=0, ddof=1)
     counts = _block_counts(ey, ex)
-
-    seed_block_means = _block_sums(stack, ey, ex) / counts          # (K, gy, gx, 3)
-    observed = seed_block_means.var(axis=0, ddof=1).sum()
     var_sum = _block_sums(pixel_var, ey, ex)                        # sum_p s2_p
-    predicted = (var_sum / counts**2).sum()
-    correlation = float(observed / predicted) if predicted > 0 else 1.0
-    inflation = max(1.0, correlation)
+    block_corr, corr_dof = _block_correlation(_block_sums(stack, ey, ex), float(var_sum.sum()))
+    lag_corr = _lag_correlation(stack - pixel_mean)
+    block_inflation = max(1.0, block_corr)
+    frame_inflation = max(1.0, block_corr, lag_corr)
 
-    def moments(mean_sum, var_sum, var2_sum, n, noisy):
-        # var of the K-average of a region mean: inflation * sum s2 / (n^2 K);
-        # each s2_p has K-1 dof, so Var-hat(s2_p) = 2 s2_p^2 / (K-1).
+    def moments(mean_sum, var_sum, var2_sum, n, noisy, inflation):
+        # var of the K-average of a region mean: inflation * sum s2 / (n^2 K).
+        # Its estimate's variance (halved, for Welch-Satterthwaite): each s2_p
+        # has K-1 dof, so Var-hat(s2_p) = 2 s2_p^2 / (K-1); an estimated
+        # inflation adds its relative variance 2 / corr_dof.  The lag factor
+        # is taken to be no noisier than the block factor (measured: less
+        # noisy at 128x128 px, equal at 64x64).
         scale = inflation / (n**2 * k)
-        return _RegionMoments(mean=mean_sum / n, var=scale * var_sum,
-                              dof_term=scale**2 * var2_sum / (k - 1), noisy=noisy)
+        var = scale * var_sum
+        dof_term = scale**2 * var2_sum / (k - 1)
+        if inflation > 1.0:
+            dof_term = dof_term + var**2 / corr_dof
+        return _RegionMoments(mean=mean_sum / n, var=var, dof_term=dof_term, noisy=noisy)
 
     n_frame = float(pixel_mean.shape[0] * pixel_mean.shape[1])
     frame = moments(pixel_mean.sum(axis=(0, 1)), pixel_var.sum(axis=(0, 1)),
-                    (pixel_var**2).sum(axis=(0, 1)), n_frame, pixel_var.max(axis=(0, 1)) > 0)
+                    (pixel_var**2).sum(axis=(0, 1)), n_frame, pixel_var.max(axis=(0, 1)) > 0,
+                    frame_inflation)
     noisy_blocks = np.maximum.reduceat(np.maximum.reduceat(pixel_var, ey[:-1], axis=0),
                                        ex[:-1], axis=1) > 0
     blocks = moments(_block_sums(pixel_mean, ey, ex), var_sum,
-                     _block_sums(pixel_var**2, ey, ex), counts, noisy_blocks)
-    return frame, blocks, correlation
+                     _block_sums(pixel_var**2, ey, ex), counts, noisy_blocks, block_inflation)
+    return frame, blocks, np.array([block_corr, lag_corr])
 
 
 @dataclass
@@ -403,7 +540,9 @@ class Agreement:
     shape               (h, w) of the images
     seeds               (K_a, K_b) renders per stack
     n_tests, n_skipped  tests run; regions x channels without noise nor difference
-    correlation         (2,) pixel correlation factor of a and b (1 = independent)
+    correlation         (2, 2) pixel correlation factors, rows a and b, columns
+                        block scale (measured) and frame scale (from lags up
+                        to MAX_CORRELATION_LAG); 1 = independent pixels
     edges_y, edges_x    (gy + 1,), (gx + 1,) int block edges in pixels
     frame_mean_a/_b     (3,) frame means
     frame_se_a/_b       (3,) their standard errors
@@ -492,7 +631,9 @@ class Agreement:
         return (f"{self.verdict}: frame a/b-1 {frame}; {n_differ}/{n_blocks} blocks differ; "
                 f"alpha={self.alpha:g} over {self.n_tests} tests ({self.n_skipped} skipped), "
                 f"K={self.seeds[0]}/{self.seeds[1]}, pixel correlation "
-                f"{self.correlation[0]:.2f}/{self.correlation[1]:.2f}")
+                f"{self.correlation[0].max():.2f}/{self.correlation[1].max():.2f}"
+                + (" (pixels not independent: denoiser or splatting filter on?)"
+                   if self.correlation.max() > CORRELATION_WARNING else ""))
 
     def to_dict(self) -> dict:
         """Plain JSON-ready dict of every field plus ``differing_blocks``,
@@ -581,7 +722,7 @@ def compare_stacks(a, b, grid=(8, 8), alpha: float = 1e-3,
     return Agreement(
         verdict=verdict, alpha=alpha, confidence=confidence, shape=(h, w),
         seeds=(a.shape[0], b.shape[0]), n_tests=int(tested.sum()),
-        n_skipped=int((~tested).sum()), correlation=np.array([corr_a, corr_b]),
+        n_skipped=int((~tested).sum()), correlation=np.stack([corr_a, corr_b]),
         edges_y=ey, edges_x=ex,
         frame_mean_a=frame_a.mean, frame_mean_b=frame_b.mean,
         frame_se_a=np.sqrt(frame_a.var), frame_se_b=np.sqrt(frame_b.var),

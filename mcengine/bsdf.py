@@ -2,16 +2,17 @@
 
 Materials are packed into one float64 table (``pack_materials``), a row per
 material with the columns ``M_*``.  The kernels dispatch on the lobes a row
-enables, in this module only.
+enables, in this module only.  Functions take the table and a row index
+(``mats, m``), not a row slice, which numba passes far more cheaply.
 
 Contract (Mitsuba's): directions are unit vectors in the local frame where the
 shading normal is +z; ``wo`` points to the viewer, ``wi`` to the light.
 
-* ``bsdf_eval(mat, wo, wi, exclude)`` returns ``f * |cos(theta_i)|`` per
+* ``bsdf_eval(mats, m, wo, wi, exclude)`` returns ``f * |cos(theta_i)|`` per
   channel and the pdf with which ``bsdf_sample`` would have produced ``wi``
   (solid angle).  Lobes whose label is in ``exclude`` (a light's ray
   visibility) add nothing to f but still count in the pdf, as in Cycles;
-* ``bsdf_sample(mat, wo, u_lobe, u1, u2)`` returns ``wi``, the weight
+* ``bsdf_sample(mats, m, wo, u_lobe, u1, u2)`` returns ``wi``, the weight
   ``f * |cos| / pdf``, the pdf and the lobe label (``LABEL_*``), which the
   integrator uses for bounce counting and light visibility.
 
@@ -60,33 +61,33 @@ def pack_materials(materials) -> np.ndarray:
 
 
 @device
-def bsdf_has_lobes(mat):
-    return mat[M_DIFFUSE_WEIGHT] > 0.0
+def bsdf_has_lobes(mats, m):
+    return mats[m, M_DIFFUSE_WEIGHT] > 0.0
 
 
 @device
-def bsdf_labels(mat):
+def bsdf_labels(mats, m):
     """Labels of all lobes of the material (what light visibility checks against)."""
-    return LABEL_REFLECT | LABEL_DIFFUSE if mat[M_DIFFUSE_WEIGHT] > 0.0 else LABEL_NONE
+    return LABEL_REFLECT | LABEL_DIFFUSE if mats[m, M_DIFFUSE_WEIGHT] > 0.0 else LABEL_NONE
 
 
 @device
-def bsdf_eval(mat, wox, woy, woz, wix, wiy, wiz, exclude):
+def bsdf_eval(mats, m, wox, woy, woz, wix, wiy, wiz, exclude):
     """(f*|cos| r, g, b, pdf) for local directions wo, wi."""
-    if mat[M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0 or wiz <= 0.0:
+    if mats[m, M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0 or wiz <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     pdf = wiz / math.pi
     if exclude & LABEL_DIFFUSE:
         return 0.0, 0.0, 0.0, pdf
-    return mat[M_BASE] * pdf, mat[M_BASE + 1] * pdf, mat[M_BASE + 2] * pdf, pdf
+    return mats[m, M_BASE] * pdf, mats[m, M_BASE + 1] * pdf, mats[m, M_BASE + 2] * pdf, pdf
 
 
 @device
-def bsdf_sample(mat, wox, woy, woz, u_lobe, u1, u2):
+def bsdf_sample(mats, m, wox, woy, woz, u_lobe, u1, u2):
     """(wix, wiy, wiz, weight r, g, b, pdf, label) for local wo."""
-    if mat[M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0:
+    if mats[m, M_DIFFUSE_WEIGHT] <= 0.0 or woz <= 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     x, y, z = cosine_hemisphere(u1, u2)
     if z <= 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-    return x, y, z, mat[M_BASE], mat[M_BASE + 1], mat[M_BASE + 2], z / math.pi, LABEL_REFLECT | LABEL_DIFFUSE
+    return x, y, z, mats[m, M_BASE], mats[m, M_BASE + 1], mats[m, M_BASE + 2], z / math.pi, LABEL_REFLECT | LABEL_DIFFUSE

@@ -34,8 +34,7 @@ from .jit import device, kernel
 from .bsdf import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
                    M_EMISSION, M_EMISSIVE, bsdf_eval, bsdf_has_lobes, bsdf_sample)
 from .camera import camera_ray
-from .intersect import (SHADOW_SHORTEN, T_INFINITE, intersect_triangle, offset_origin,
-                        offset_scale)
+from .intersect import SHADOW_SHORTEN, T_INFINITE, intersect_prim, offset_origin, offset_scale
 from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW,
                      LF_USE_MIS, LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY,
                      LF_VIS_TRANSMISSION, LT_SUN, intersect_lamp, pick_light, sample_lamp,
@@ -86,6 +85,7 @@ SceneData = namedtuple("SceneData", [
     "emit_pmf",      # (NE,) f64    their NEE probabilities
     "tri_light",     # (T,) int32   index into emit_tri, or -1
     "tri_area",      # (T,) f64
+    "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
     "world",         # (3,) f64     background radiance
     "camera",        # (CAMERA_PARAMS,) f64
     "filter_table",  # (FILTER_TABLE_SIZE,) f64
@@ -283,8 +283,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         # rounding, triangles being flat): continue from just past it.
         if p >= 0 and p == st.self_prim[i]:
             stats[ST_SELF_HITS] += 1
-            v0, v1, v2 = sc.verts[sc.tris[p, 0]], sc.verts[sc.tris[p, 1]], sc.verts[sc.tris[p, 2]]
-            t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2)
+            t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
             if not math.isfinite(t) or t < 0.0:
                 t = 0.0
             s = offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
@@ -296,29 +295,33 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         t_hit = st.ray_tmax[i]
         b1 = b2 = 0.0
         if p >= 0:
-            v0, v1, v2 = sc.verts[sc.tris[p, 0]], sc.verts[sc.tris[p, 1]], sc.verts[sc.tris[p, 2]]
-            t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2)
+            t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
             t_hit = t if (math.isfinite(t) and t > 0.0) else 0.0
         arrival_direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
 
         # -- lamps along the ray (they do not block it) --------------------------------
         if lamps_hit:
             last_t = 0.0
-            while True:
-                # The nearest lamp beyond last_t (lamps are few; rays pass through them).
+            more = True
+            while more:
+                # The nearest lamp beyond last_t (lamps are few; rays pass through
+                # them); another pass only if this one saw several.
                 best_t = t_hit
                 best = -1
+                n_hits = 0
                 br = bg = bb = bpdf = 0.0
                 for li in range(n_lamps):
-                    lamp = sc.lamps[li]
-                    if not _lamp_visible_to_ray(flags, int(lamp[L_FLAGS])):
+                    if not _lamp_visible_to_ray(flags, int(sc.lamps[li, L_FLAGS])):
                         continue
-                    tl, lr, lg, lb, lpdf = intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, best_t)
-                    if tl > last_t and tl < best_t:
-                        best_t, best = tl, li
-                        br, bg, bb, bpdf = lr, lg, lb, lpdf
+                    tl, lr, lg, lb, lpdf = intersect_lamp(sc.lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
+                    if tl > last_t and tl < t_hit:
+                        n_hits += 1
+                        if tl < best_t:
+                            best_t, best = tl, li
+                            br, bg, bb, bpdf = lr, lg, lb, lpdf
                 if best < 0:
                     break
+                more = n_hits > 1
                 w = 1.0
                 if not (flags & PF_MIS_SKIP):
                     w = power_heuristic(st.mis_pdf[i], sc.lamps[best, L_PMF] * bpdf)
@@ -340,33 +343,29 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                 _add(st, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
                      st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
             for li in range(n_lamps):
-                lamp = sc.lamps[li]
-                if int(lamp[L_TYPE]) != LT_SUN or lamp[L_SUN_COS] >= 1.0:
+                if int(sc.lamps[li, L_TYPE]) != LT_SUN or sc.lamps[li, L_SUN_COS] >= 1.0:
                     continue
-                lflags = int(lamp[L_FLAGS])
+                lflags = int(sc.lamps[li, L_FLAGS])
                 if not (lflags & LF_USE_MIS) or not _lamp_visible_to_ray(flags, lflags):
                     continue
-                lr, lg, lb, lpdf = sun_radiance(lamp, dx, dy, dz)
+                lr, lg, lb, lpdf = sun_radiance(sc.lamps, li, dx, dy, dz)
                 if lpdf > 0.0:
                     w = 1.0
                     if not (flags & PF_MIS_SKIP):
-                        w = power_heuristic(st.mis_pdf[i], lamp[L_PMF] * lpdf)
+                        w = power_heuristic(st.mis_pdf[i], sc.lamps[li, L_PMF] * lpdf)
                     _add(st, i, st.beta[i, 0] * lr * w, st.beta[i, 1] * lg * w,
                          st.beta[i, 2] * lb * w, arrival_direct, fcfg, stats)
             continue
 
         # -- surface hit ---------------------------------------------------------------
-        hx = v0[0] + b1 * (v1[0] - v0[0]) + b2 * (v2[0] - v0[0])
-        hy = v0[1] + b1 * (v1[1] - v0[1]) + b2 * (v2[1] - v0[1])
-        hz = v0[2] + b1 * (v1[2] - v0[2]) + b2 * (v2[2] - v0[2])
-        e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
-        e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
-        ngx, ngy, ngz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
-        ln = math.sqrt(ngx * ngx + ngy * ngy + ngz * ngz)
-        if ln == 0.0:
+        if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
-        ngx, ngy, ngz = ngx / ln, ngy / ln, ngz / ln
         b0 = 1.0 - b1 - b2
+        va, vb, vc = sc.tris[p, 0], sc.tris[p, 1], sc.tris[p, 2]
+        hx = b0 * sc.verts[va, 0] + b1 * sc.verts[vb, 0] + b2 * sc.verts[vc, 0]
+        hy = b0 * sc.verts[va, 1] + b1 * sc.verts[vb, 1] + b2 * sc.verts[vc, 1]
+        hz = b0 * sc.verts[va, 2] + b1 * sc.verts[vb, 2] + b2 * sc.verts[vc, 2]
+        ngx, ngy, ngz = sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2]
         nsx = b0 * sc.normals[p, 0, 0] + b1 * sc.normals[p, 1, 0] + b2 * sc.normals[p, 2, 0]
         nsy = b0 * sc.normals[p, 0, 1] + b1 * sc.normals[p, 1, 1] + b2 * sc.normals[p, 2, 1]
         nsz = b0 * sc.normals[p, 0, 2] + b1 * sc.normals[p, 1, 2] + b2 * sc.normals[p, 2, 2]
@@ -385,7 +384,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             ngx, ngy, ngz = -ngx, -ngy, -ngz
             nsx, nsy, nsz = -nsx, -nsy, -nsz
             cos_o_geo = -cos_o_geo
-        mat = sc.materials[sc.mat_index[p]]
+        m = sc.mat_index[p]
 
         # Russian roulette (Cycles: from the third vertex on, with the
         # throughput as it is; emission here is not affected by it).
@@ -394,17 +393,18 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
 
         # Emission (two-sided).
-        if mat[M_EMISSIVE] > 0.0:
+        if sc.materials[m, M_EMISSIVE] > 0.0:
             w = 1.0
             if not (flags & PF_MIS_SKIP):
                 j = sc.tri_light[p]
                 if j >= 0:
                     light_pdf = sc.emit_pmf[j] * t_hit * t_hit / (sc.tri_area[p] * cos_o_geo)
                     w = power_heuristic(st.mis_pdf[i], light_pdf)
-            _add(st, i, st.beta[i, 0] * mat[M_EMISSION] * w, st.beta[i, 1] * mat[M_EMISSION + 1] * w,
-                 st.beta[i, 2] * mat[M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
+            _add(st, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
+                 st.beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
+                 st.beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
 
-        if (flags & PF_TERMINATE) or not bsdf_has_lobes(mat):
+        if (flags & PF_TERMINATE) or not bsdf_has_lobes(sc.materials, m):
             continue
         bounce = st.bounce[i]
         key = st.key[i]
@@ -436,11 +436,10 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             cast_shadow = True
             exclude = 0
             if idx < n_lamps:
-                lamp = sc.lamps[idx]
-                lflags = int(lamp[L_FLAGS])
-                if bounce <= lamp[L_MAX_BOUNCES]:
-                    wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamp, hx, hy, hz, u1, u2)
-                    pmf = lamp[L_PMF]
+                lflags = int(sc.lamps[idx, L_FLAGS])
+                if bounce <= sc.lamps[idx, L_MAX_BOUNCES]:
+                    wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(sc.lamps, idx, hx, hy, hz, u1, u2)
+                    pmf = sc.lamps[idx, L_PMF]
                     use_mis = (lflags & LF_USE_MIS) != 0
                     cast_shadow = (lflags & LF_CAST_SHADOW) != 0
                     exclude = _nee_exclude(lflags)
@@ -453,30 +452,25 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             else:
                 j = idx - n_lamps
                 tri = sc.emit_tri[j]
-                e0, e1, e2 = sc.verts[sc.tris[tri, 0]], sc.verts[sc.tris[tri, 1]], sc.verts[sc.tris[tri, 2]]
-                qx, qy, qz = sample_triangle_point(e0, e1, e2, u1, u2)
+                qx, qy, qz = sample_triangle_point(sc.verts, sc.tris, tri, u1, u2)
                 lx, ly, lz = qx - hx, qy - hy, qz - hz
                 d2 = lx * lx + ly * ly + lz * lz
                 dist = math.sqrt(d2)
                 if dist > 0.0:
                     wix, wiy, wiz = lx / dist, ly / dist, lz / dist
-                    fx_ = (e1[1] - e0[1]) * (e2[2] - e0[2]) - (e1[2] - e0[2]) * (e2[1] - e0[1])
-                    fy_ = (e1[2] - e0[2]) * (e2[0] - e0[0]) - (e1[0] - e0[0]) * (e2[2] - e0[2])
-                    fz_ = (e1[0] - e0[0]) * (e2[1] - e0[1]) - (e1[1] - e0[1]) * (e2[0] - e0[0])
-                    # |cos| at the light: the cross product's length is twice the area.
-                    lnx, lny, lnz = (fx_ / (2.0 * sc.tri_area[tri]), fy_ / (2.0 * sc.tri_area[tri]),
-                                     fz_ / (2.0 * sc.tri_area[tri]))
+                    lnx, lny, lnz = sc.tri_normal[tri, 0], sc.tri_normal[tri, 1], sc.tri_normal[tri, 2]
                     cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
                     if cos_l > 0.0:
                         pdf_l = sc.emit_pmf[j] * d2 / (sc.tri_area[tri] * cos_l)
-                        em = sc.materials[sc.mat_index[tri]]
-                        lr, lg, lb = (em[M_EMISSION] / pdf_l, em[M_EMISSION + 1] / pdf_l,
-                                      em[M_EMISSION + 2] / pdf_l)
+                        em = sc.mat_index[tri]
+                        lr = sc.materials[em, M_EMISSION] / pdf_l
+                        lg = sc.materials[em, M_EMISSION + 1] / pdf_l
+                        lb = sc.materials[em, M_EMISSION + 2] / pdf_l
             if lr + lg + lb > 0.0 and dist > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
                 wlx = wix * tx + wiy * ty + wiz * tz
                 wly = wix * bx + wiy * by + wiz * bz
                 wlz = wix * nsx + wiy * nsy + wiz * nsz
-                fr, fg, fb, bsdf_pdf = bsdf_eval(mat, wox, woy, woz, wlx, wly, wlz, exclude)
+                fr, fg, fb, bsdf_pdf = bsdf_eval(sc.materials, m, wox, woy, woz, wlx, wly, wlz, exclude)
                 w = power_heuristic(pdf_l, bsdf_pdf) if use_mis else 1.0
                 cr = st.beta[i, 0] * fr * lr * w
                 cg = st.beta[i, 1] * fg * lg * w
@@ -513,7 +507,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # -- BSDF sampling: the next ray ---------------------------------------------------
         wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
-            mat, wox, woy, woz, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
+            sc.materials, m, wox, woy, woz, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
             rand(key, bounce_dim(bounce, DIM_BSDF_U)), rand(key, bounce_dim(bounce, DIM_BSDF_V)))
         if pdf <= 0.0 or wr + wg + wb <= 0.0:
             continue

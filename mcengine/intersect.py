@@ -95,7 +95,7 @@ def offset_origin(px, py, pz, ngx, ngy, ngz, dx, dy, dz):
 
 
 @device
-def intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2):
+def intersect_triangle(ox, oy, oz, dx, dy, dz, v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z):
     """Plane hit of a ray with a triangle, in float64.
 
     Returns ``(t, b1, b2)`` with barycentrics clamped into the triangle (the
@@ -103,17 +103,17 @@ def intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2):
     the difference between Embree's float32 test and this one at edges).
     ``t`` is NaN if the ray is parallel to the plane.
     """
-    e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
-    e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+    e1x, e1y, e1z = v1x - v0x, v1y - v0y, v1z - v0z
+    e2x, e2y, e2z = v2x - v0x, v2y - v0y, v2z - v0z
     nx = e1y * e2z - e1z * e2y
     ny = e1z * e2x - e1x * e2z
     nz = e1x * e2y - e1y * e2x
     denom = nx * dx + ny * dy + nz * dz
     if denom == 0.0:
         return math.nan, 0.0, 0.0
-    t = (nx * (v0[0] - ox) + ny * (v0[1] - oy) + nz * (v0[2] - oz)) / denom
+    t = (nx * (v0x - ox) + ny * (v0y - oy) + nz * (v0z - oz)) / denom
     # Barycentrics of the plane hit by projecting onto the edges (Gram matrix).
-    px, py, pz = ox + t * dx - v0[0], oy + t * dy - v0[1], oz + t * dz - v0[2]
+    px, py, pz = ox + t * dx - v0x, oy + t * dy - v0y, oz + t * dz - v0z
     d00 = e1x * e1x + e1y * e1y + e1z * e1z
     d01 = e1x * e2x + e1y * e2y + e1z * e2z
     d11 = e2x * e2x + e2y * e2y + e2z * e2z
@@ -131,3 +131,13 @@ def intersect_triangle(ox, oy, oz, dx, dy, dz, v0, v1, v2):
         b1 /= s
         b2 /= s
     return t, b1, b2
+
+
+@device
+def intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p):
+    """:func:`intersect_triangle` for triangle ``p`` of the scene tables."""
+    a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
+    return intersect_triangle(ox, oy, oz, dx, dy, dz,
+                              verts[a, 0], verts[a, 1], verts[a, 2],
+                              verts[b, 0], verts[b, 1], verts[b, 2],
+                              verts[c, 0], verts[c, 1], verts[c, 2])

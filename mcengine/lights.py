@@ -1,7 +1,10 @@
 """Lights: Blender lamps and emissive triangles, in Cycles' units.
 
 Lamps are packed into a float64 table (``pack_lights``), a row per lamp with
-the columns ``L_*``; emissive triangles are listed separately.  One discrete
+the columns ``L_*``; emissive triangles are listed separately.  Kernel
+functions take the whole table and a row index (``lamps, li``), never a row
+slice: in numba, passing an array view to a function that is not inlined
+costs tens of nanoseconds, more than the arithmetic here.  One discrete
 distribution over "all lamps, then all emissive triangles" picks the light
 for next-event estimation, in proportion to an estimate of its power.
 
@@ -201,36 +204,36 @@ def _smoothstep(t):
 
 
 @device
-def spot_attenuation(lamp, ex, ey, ez):
+def spot_attenuation(lamps, li, ex, ey, ez):
     """Cone attenuation for the emission direction e (light towards the point)."""
-    inv = lamp[L_SPOT_INV:L_SPOT_INV + 9]
-    lx = inv[0] * ex + inv[1] * ey + inv[2] * ez
-    ly = inv[3] * ex + inv[4] * ey + inv[5] * ez
-    lz = inv[6] * ex + inv[7] * ey + inv[8] * ez
+    k = L_SPOT_INV
+    lx = lamps[li, k] * ex + lamps[li, k + 1] * ey + lamps[li, k + 2] * ez
+    ly = lamps[li, k + 3] * ex + lamps[li, k + 4] * ey + lamps[li, k + 5] * ez
+    lz = lamps[li, k + 6] * ex + lamps[li, k + 7] * ey + lamps[li, k + 8] * ez
     ln = math.sqrt(lx * lx + ly * ly + lz * lz)
     if ln == 0.0:
         return 0.0
     cos_a = -lz / ln
-    c = lamp[L_SPOT_COS]
-    if lamp[L_SPOT_SMOOTH] == 0.0:
+    c = lamps[li, L_SPOT_COS]
+    if lamps[li, L_SPOT_SMOOTH] == 0.0:
         return 1.0 if cos_a > c else 0.0
-    return _smoothstep((cos_a - c) * lamp[L_SPOT_SMOOTH])
+    return _smoothstep((cos_a - c) * lamps[li, L_SPOT_SMOOTH])
 
 
 @device
-def area_spread(lamp, cos_l):
+def area_spread(lamps, li, cos_l):
     """Spread attenuation at emission angle theta (cos_l = cos theta)."""
-    t = lamp[L_SPREAD_TAN]
+    t = lamps[li, L_SPREAD_TAN]
     if t < 0.0:
         return 1.0
     if cos_l <= 0.0:
         return 0.0
     tan_theta = math.sqrt(max(0.0, 1.0 - cos_l * cos_l)) / cos_l
-    return max(t - tan_theta, 0.0) * lamp[L_SPREAD_NORM]
+    return max(t - tan_theta, 0.0) * lamps[li, L_SPREAD_NORM]
 
 
 @device
-def sample_lamp(lamp, px, py, pz, u1, u2):
+def sample_lamp(lamps, li, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
 
     Returns ``(wix, wiy, wiz, dist, Lr, Lg, Lb, pdf)``: the unit direction
@@ -239,32 +242,32 @@ def sample_lamp(lamp, px, py, pz, u1, u2):
     pdf of wi.  ``pdf == 0`` with a non-zero L means a delta light whose L is
     already the irradiance-equivalent (L/pdf term); ``L == 0`` means no light.
     """
-    typ = int(lamp[L_TYPE])
+    typ = int(lamps[li, L_TYPE])
     if typ == LT_SUN:
-        azx, azy, azz = lamp[L_AZ], lamp[L_AZ + 1], lamp[L_AZ + 2]
-        cos_max = lamp[L_SUN_COS]
+        azx, azy, azz = lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2]
+        cos_max = lamps[li, L_SUN_COS]
         if cos_max >= 1.0:
-            return azx, azy, azz, math.inf, lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2], 0.0
+            return azx, azy, azz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], 0.0
         x, y, z = uniform_cone(u1, u2, cos_max)
         tx, ty, tz, bx, by, bz = orthonormal_basis(azx, azy, azz)
         wx = x * tx + y * bx + z * azx
         wy = x * ty + y * by + z * azy
         wz = x * tz + y * bz + z * azz
-        return (wx, wy, wz, math.inf, lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2],
+        return (wx, wy, wz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2],
                 uniform_cone_pdf(cos_max))
 
-    cx, cy, cz = lamp[L_POS], lamp[L_POS + 1], lamp[L_POS + 2]
+    cx, cy, cz = lamps[li, L_POS], lamps[li, L_POS + 1], lamps[li, L_POS + 2]
     if typ == LT_AREA:
-        hx, hy = lamp[L_HALF_X], lamp[L_HALF_Y]
-        if lamp[L_AREA] <= 0.0:
+        hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
+        if lamps[li, L_AREA] <= 0.0:
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        if lamp[L_ELLIPSE] > 0.0:
+        if lamps[li, L_ELLIPSE] > 0.0:
             a, b = disk_concentric(u1, u2)
         else:
             a, b = 2.0 * u1 - 1.0, 2.0 * u2 - 1.0
-        qx = cx + a * hx * lamp[L_AX] + b * hy * lamp[L_AY]
-        qy = cy + a * hx * lamp[L_AX + 1] + b * hy * lamp[L_AY + 1]
-        qz = cz + a * hx * lamp[L_AX + 2] + b * hy * lamp[L_AY + 2]
+        qx = cx + a * hx * lamps[li, L_AX] + b * hy * lamps[li, L_AY]
+        qy = cy + a * hx * lamps[li, L_AX + 1] + b * hy * lamps[li, L_AY + 1]
+        qz = cz + a * hx * lamps[li, L_AX + 2] + b * hy * lamps[li, L_AY + 2]
         dx, dy, dz = qx - px, qy - py, qz - pz
         d2 = dx * dx + dy * dy + dz * dz
         dist = math.sqrt(d2)
@@ -272,16 +275,16 @@ def sample_lamp(lamp, px, py, pz, u1, u2):
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
         wx, wy, wz = dx / dist, dy / dist, dz / dist
         # One-sided: the lamp emits along -Z, so wi (towards it) must go along +Z.
-        cos_l = wx * lamp[L_AZ] + wy * lamp[L_AZ + 1] + wz * lamp[L_AZ + 2]
+        cos_l = wx * lamps[li, L_AZ] + wy * lamps[li, L_AZ + 1] + wz * lamps[li, L_AZ + 2]
         if cos_l <= 0.0:
             return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
-        s = area_spread(lamp, cos_l)
-        pdf = d2 / (lamp[L_AREA] * cos_l)
-        return (wx, wy, wz, dist, s * lamp[L_RADIANCE], s * lamp[L_RADIANCE + 1],
-                s * lamp[L_RADIANCE + 2], pdf)
+        s = area_spread(lamps, li, cos_l)
+        pdf = d2 / (lamps[li, L_AREA] * cos_l)
+        return (wx, wy, wz, dist, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1],
+                s * lamps[li, L_RADIANCE + 2], pdf)
 
     # Point and spot lamps.
-    r = lamp[L_RADIUS]
+    r = lamps[li, L_RADIUS]
     dx, dy, dz = cx - px, cy - py, cz - pz
     d2 = dx * dx + dy * dy + dz * dz
     d = math.sqrt(d2)
@@ -292,13 +295,13 @@ def sample_lamp(lamp, px, py, pz, u1, u2):
         # Delta light: return intensity / d^2 as the L/pdf term.
         att = 1.0
         if typ == LT_SPOT:
-            att = spot_attenuation(lamp, -nx, -ny, -nz)
+            att = spot_attenuation(lamps, li, -nx, -ny, -nz)
         k = att / d2
-        return (nx, ny, nz, d, k * lamp[L_RADIANCE], k * lamp[L_RADIANCE + 1],
-                k * lamp[L_RADIANCE + 2], 0.0)
+        return (nx, ny, nz, d, k * lamps[li, L_RADIANCE], k * lamps[li, L_RADIANCE + 1],
+                k * lamps[li, L_RADIANCE + 2], 0.0)
     if d <= r:
         return nx, ny, nz, d, 0.0, 0.0, 0.0, 0.0   # inside the lamp: no defined direction
-    if lamp[L_DISK] > 0.0:
+    if lamps[li, L_DISK] > 0.0:
         # Disk of radius r through the centre, facing p.
         a, b = disk_concentric(u1, u2)
         tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
@@ -329,44 +332,44 @@ def sample_lamp(lamp, px, py, pz, u1, u2):
         pdf = uniform_cone_pdf(cos_max)
     att = 1.0
     if typ == LT_SPOT:
-        att = spot_attenuation(lamp, -wx, -wy, -wz)
-    return (wx, wy, wz, dist, att * lamp[L_RADIANCE], att * lamp[L_RADIANCE + 1],
-            att * lamp[L_RADIANCE + 2], pdf)
+        att = spot_attenuation(lamps, li, -wx, -wy, -wz)
+    return (wx, wy, wz, dist, att * lamps[li, L_RADIANCE], att * lamps[li, L_RADIANCE + 1],
+            att * lamps[li, L_RADIANCE + 2], pdf)
 
 
 @device
-def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
+def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax):
     """A ray through a lamp: ``(t, Lr, Lg, Lb, pdf)``, t = inf if it misses.
 
     ``pdf`` is the solid-angle pdf with which :func:`sample_lamp` would pick
     this direction from the ray origin (for MIS).  Suns are handled by
     :func:`sun_radiance` on escaped rays.
     """
-    typ = int(lamp[L_TYPE])
+    typ = int(lamps[li, L_TYPE])
     if typ == LT_SUN:
         return math.inf, 0.0, 0.0, 0.0, 0.0
-    cx, cy, cz = lamp[L_POS], lamp[L_POS + 1], lamp[L_POS + 2]
+    cx, cy, cz = lamps[li, L_POS], lamps[li, L_POS + 1], lamps[li, L_POS + 2]
     if typ == LT_AREA:
-        azx, azy, azz = lamp[L_AZ], lamp[L_AZ + 1], lamp[L_AZ + 2]
+        azx, azy, azz = lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2]
         cos_l = dx * azx + dy * azy + dz * azz       # > 0: the ray meets the emitting side
-        if cos_l <= 0.0 or lamp[L_AREA] <= 0.0:
+        if cos_l <= 0.0 or lamps[li, L_AREA] <= 0.0:
             return math.inf, 0.0, 0.0, 0.0, 0.0
         t = ((cx - ox) * azx + (cy - oy) * azy + (cz - oz) * azz) / cos_l
         if t <= 0.0 or t >= tmax:
             return math.inf, 0.0, 0.0, 0.0, 0.0
         hx, hy, hz = ox + t * dx - cx, oy + t * dy - cy, oz + t * dz - cz
-        a = (hx * lamp[L_AX] + hy * lamp[L_AX + 1] + hz * lamp[L_AX + 2]) / lamp[L_HALF_X]
-        b = (hx * lamp[L_AY] + hy * lamp[L_AY + 1] + hz * lamp[L_AY + 2]) / lamp[L_HALF_Y]
-        if lamp[L_ELLIPSE] > 0.0:
+        a = (hx * lamps[li, L_AX] + hy * lamps[li, L_AX + 1] + hz * lamps[li, L_AX + 2]) / lamps[li, L_HALF_X]
+        b = (hx * lamps[li, L_AY] + hy * lamps[li, L_AY + 1] + hz * lamps[li, L_AY + 2]) / lamps[li, L_HALF_Y]
+        if lamps[li, L_ELLIPSE] > 0.0:
             if a * a + b * b > 1.0:
                 return math.inf, 0.0, 0.0, 0.0, 0.0
         elif abs(a) > 1.0 or abs(b) > 1.0:
             return math.inf, 0.0, 0.0, 0.0, 0.0
-        s = area_spread(lamp, cos_l)
-        pdf = t * t / (lamp[L_AREA] * cos_l)
-        return t, s * lamp[L_RADIANCE], s * lamp[L_RADIANCE + 1], s * lamp[L_RADIANCE + 2], pdf
+        s = area_spread(lamps, li, cos_l)
+        pdf = t * t / (lamps[li, L_AREA] * cos_l)
+        return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], pdf
 
-    r = lamp[L_RADIUS]
+    r = lamps[li, L_RADIUS]
     if r <= 0.0:
         return math.inf, 0.0, 0.0, 0.0, 0.0
     px, py, pz = cx - ox, cy - oy, cz - oz
@@ -374,7 +377,7 @@ def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
     if d2 <= r * r:
         return math.inf, 0.0, 0.0, 0.0, 0.0
     d = math.sqrt(d2)
-    if lamp[L_DISK] > 0.0:
+    if lamps[li, L_DISK] > 0.0:
         # Disk through the centre facing the ray origin.
         nx, ny, nz = px / d, py / d, pz / d
         cos_l = dx * nx + dy * ny + dz * nz
@@ -398,25 +401,27 @@ def intersect_lamp(lamp, ox, oy, oz, dx, dy, dz, tmax):
         pdf = uniform_cone_pdf(math.sqrt(max(0.0, 1.0 - r * r / d2)))
     att = 1.0
     if typ == LT_SPOT:
-        att = spot_attenuation(lamp, -dx, -dy, -dz)
-    return t, att * lamp[L_RADIANCE], att * lamp[L_RADIANCE + 1], att * lamp[L_RADIANCE + 2], pdf
+        att = spot_attenuation(lamps, li, -dx, -dy, -dz)
+    return t, att * lamps[li, L_RADIANCE], att * lamps[li, L_RADIANCE + 1], att * lamps[li, L_RADIANCE + 2], pdf
 
 
 @device
-def sun_radiance(lamp, dx, dy, dz):
+def sun_radiance(lamps, li, dx, dy, dz):
     """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d."""
-    cos_max = lamp[L_SUN_COS]
+    cos_max = lamps[li, L_SUN_COS]
     if cos_max >= 1.0:
         return 0.0, 0.0, 0.0, 0.0
-    if dx * lamp[L_AZ] + dy * lamp[L_AZ + 1] + dz * lamp[L_AZ + 2] < cos_max:
+    if dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2] < cos_max:
         return 0.0, 0.0, 0.0, 0.0
-    return lamp[L_RADIANCE], lamp[L_RADIANCE + 1], lamp[L_RADIANCE + 2], uniform_cone_pdf(cos_max)
+    return lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], uniform_cone_pdf(cos_max)
 
 
 @device
-def sample_triangle_point(v0, v1, v2, u1, u2):
+def sample_triangle_point(verts, tris, tri, u1, u2):
+    """Uniform point on triangle ``tri``."""
     b1, b2 = uniform_triangle(u1, u2)
     b0 = 1.0 - b1 - b2
-    return (b0 * v0[0] + b1 * v1[0] + b2 * v2[0],
-            b0 * v0[1] + b1 * v1[1] + b2 * v2[1],
-            b0 * v0[2] + b1 * v1[2] + b2 * v2[2])
+    a, b, c = tris[tri, 0], tris[tri, 1], tris[tri, 2]
+    return (b0 * verts[a, 0] + b1 * verts[b, 0] + b2 * verts[c, 0],
+            b0 * verts[a, 1] + b1 * verts[b, 1] + b2 * verts[c, 1],
+            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2])

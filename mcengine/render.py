@@ -125,10 +125,14 @@ def build_scene_data(scene: SceneDescription):
     tris = np.ascontiguousarray(g.triangles, np.int32)
     if len(tris):
         p = verts[tris]
-        tri_area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        length = np.linalg.norm(cross, axis=1)
+        tri_area = 0.5 * length
+        tri_normal = cross / np.where(length > 0, length, 1.0)[:, None]
         lo, hi = verts.min(axis=0), verts.max(axis=0)
     else:
         tri_area = np.zeros(0)
+        tri_normal = np.zeros((0, 3))
         lo = hi = np.zeros(3)
     lamp_pos = [np.asarray(li.matrix_world, float)[:3, 3] for li in scene.lights if li.type != "SUN"]
     if lamp_pos:
@@ -158,7 +162,7 @@ def build_scene_data(scene: SceneDescription):
         mat_index=mat_index, materials=materials,
         lamps=lamps,
         light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, tri_light=tri_light,
-        tri_area=tri_area, world=world, camera=pack_camera(scene.camera, film),
+        tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
         filter_table=filter_table(film.filter_type, film.filter_width))
 
     it = scene.integrator

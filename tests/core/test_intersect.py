@@ -42,7 +42,7 @@ def test_closest_hit_matches_brute_force():
     assert agree.mean() > 0.995
     for i in np.flatnonzero(~agree):
         assert prim[i] >= 0 and ref[i] >= 0
-        t, _, _ = intersect_triangle(*o[i], *d[i], *tris32[prim[i]])
+        t, _, _ = intersect_triangle(*o[i], *d[i], *tris32[prim[i]].ravel())
         assert abs(t - tref[i]) < 1e-4 * max(1.0, tref[i])
     assert (ref >= 0).sum() > 300   # the test exercises hits, not just misses
 
@@ -66,5 +66,5 @@ def test_empty_scene_misses():
 
 def test_float64_refinement_is_exact_on_a_known_hit():
     v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], float)
-    t, b1, b2 = intersect_triangle(0.5, 0.25, 3.0, 0.0, 0.0, -1.0, v[0], v[1], v[2])
+    t, b1, b2 = intersect_triangle(0.5, 0.25, 3.0, 0.0, 0.0, -1.0, *v.ravel())
     assert (t, b1, b2) == (3.0, 0.25, 0.125)

@@ -1,0 +1,102 @@
+"""Paths per second of MC Engine and Cycles on the Cornell box, head to head.
+
+Both engines render blend_scenes/cornell_box.blend through
+``bpy.ops.render.render`` in this process, with the file's bounces (8), no
+clamping, no denoising, no adaptive sampling, the same resolution and samples,
+alternating engine by engine for several rounds (this machine's speed drifts,
+so only same-run ratios mean something).  A "path" is one camera sample.
+
+Two figures per engine:
+
+* wall: pixels x samples / wall time of the whole render call (export, BVH,
+  kernel loading and Cycles' scene sync included);
+* marginal: the extra paths of a full render over a 1-sample render, divided by
+  the extra time, which removes each engine's fixed start-up cost.
+
+For MC Engine it also prints the share of worker time spent inside Embree,
+rays per path, and the peak resident memory of the process (Blender included)
+and of the renderer's own buffers.
+
+Run: python benchmarks/bench_cornell.py [--samples N] [--resolution N] [--rounds R]
+"""
+from __future__ import annotations
+
+import argparse
+import resource
+import statistics
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+SCENE = REPO / "blend_scenes" / "cornell_box.blend"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--samples", type=int, default=128)
+    ap.add_argument("--resolution", type=int, default=256)
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args(argv)
+
+    import bpy  # noqa: F401  (Blender as a module)
+    from mcengine_blender import batch, engine
+
+    batch.ensure_registered()
+    sessions = []
+    real_factory = engine.session_factory
+
+    def recording_factory(desc, threads=None):
+        s = real_factory(desc, threads=threads)
+        sessions.append(s)
+        return s
+
+    engine.session_factory = recording_factory
+    res = (args.resolution, args.resolution)
+    pixels = args.resolution * args.resolution
+
+    def run(bl_engine, samples):
+        scene = batch.open_blend(SCENE)
+        batch.make_unbiased(scene)
+        return batch.render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
+
+    # Warm-up: load numba's kernel cache and Cycles' kernels once.
+    run("mcengine", 1)
+    run("cycles", 1)
+    figures = {"MCENGINE": {"wall": [], "marginal": []}, "CYCLES": {"wall": [], "marginal": []}}
+    our_stats = []
+    for r in range(args.rounds):
+        order = ("cycles", "mcengine") if r % 2 == 0 else ("mcengine", "cycles")
+        for name in order:
+            one = run(name, 1)
+            full = run(name, args.samples)
+            f = figures[full.engine]
+            f["wall"].append(pixels * args.samples / full.seconds)
+            f["marginal"].append(pixels * (args.samples - 1) / max(full.seconds - one.seconds, 1e-9))
+            if full.engine == "MCENGINE":
+                our_stats.append(sessions[-1].stats)
+            print(f"round {r + 1}: {full.engine:9s} {args.samples} spp {full.seconds:6.2f} s "
+                  f"(1 spp {one.seconds:5.2f} s)", flush=True)
+
+    med = {e: {k: statistics.median(v) for k, v in f.items()} for e, f in figures.items()}
+    st = our_stats[-1]
+    session = sessions[-1]
+    buffers = sum(a.nbytes for w in session._all_workers for a in (*w.state, *w.shadow))
+    buffers += sum(a.nbytes for a in session.film.arrays)
+    print()
+    print(f"Cornell box {args.resolution}x{args.resolution}, {args.samples} spp, 8 bounces, "
+          f"medians of {args.rounds} rounds")
+    print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}")
+    for e in ("MCENGINE", "CYCLES"):
+        print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}")
+    print(f"{'ratio':12s}{med['MCENGINE']['wall'] / med['CYCLES']['wall']:15.2f}"
+          f"{med['MCENGINE']['marginal'] / med['CYCLES']['marginal']:20.2f}")
+    print(f"MC Engine: {st.rays / st.paths:.2f} rays/path, {st.rays_per_second / 1e6:.1f} Mrays/s, "
+          f"Embree {100 * st.embree_share:.0f} % of worker time, kernels loaded in "
+          f"{st.time_kernels:.2f} s, BVH {st.time_bvh * 1e3:.0f} ms")
+    print(f"memory: renderer buffers {buffers / 2**20:.0f} MiB; process peak RSS "
+          f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB (Blender included)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

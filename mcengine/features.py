@@ -3,8 +3,9 @@
 The render asks this module before it starts, so that no work is done for
 what the scene does not contain: no shadow rays without lights, no lamp
 intersection tests when no lamp can be hit, no background lookups for a black
-world.  Later effects (depth of field, motion blur, glossy and transmissive
-lobes) report here too; today they are all absent by construction.
+world.  Glossy (mirror, glass) and transmissive lobes are found from the materials
+the triangles use; depth of field and motion blur are not supported yet and
+are always absent.
 """
 from __future__ import annotations
 
@@ -35,8 +36,8 @@ class Features:
             lights.append("world")
         effects = [name for name, on in (("depth of field", self.depth_of_field),
                                          ("motion blur", self.motion_blur),
-                                         ("glossy", self.glossy),
-                                         ("transmission", self.transmission)) if on]
+                                         ("sharp reflection", self.glossy),
+                                         ("refraction", self.transmission)) if on]
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
                 f"effects: {', '.join(effects) if effects else 'diffuse only'}")
 
@@ -55,7 +56,12 @@ def lamp_can_be_hit(light) -> bool:
 def detect(scene, emissive_triangles: int, lamp_power) -> Features:
     """Features of ``scene`` given its emissive triangle count and lamp powers."""
     lamps = [li for li, pw in zip(scene.lights, lamp_power) if pw > 0.0]
+    used = set(np.unique(scene.geometry.material_index).tolist())
+    mats = [m for i, m in enumerate(scene.materials) if i in used]
+    has = lambda attr: any(max(getattr(m, attr)) > 0.0 for m in mats)  # noqa: E731
     return Features(
+        glossy=has("mirror_color") or has("glass_color"),
+        transmission=has("glass_color") or has("refraction_color"),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
         world=bool(np.max(np.asarray(scene.world.color, float)) > 0.0),

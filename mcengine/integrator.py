@@ -380,7 +380,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             nsx, nsy, nsz = ngx, ngy, ngz
         # All BSDFs are two-sided: face the normals towards the incoming ray.
         cos_o_geo = -(dx * ngx + dy * ngy + dz * ngz)
-        if cos_o_geo < 0.0:
+        backfacing = cos_o_geo < 0.0     # arrived from inside: glass inverts its IOR
+        if backfacing:
             ngx, ngy, ngz = -ngx, -ngy, -ngz
             nsx, nsy, nsz = -nsx, -nsy, -nsz
             cos_o_geo = -cos_o_geo
@@ -507,9 +508,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # -- BSDF sampling: the next ray ---------------------------------------------------
         wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
-            sc.materials, m, wox, woy, woz, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
+            sc.materials, m, wox, woy, woz, backfacing, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
             rand(key, bounce_dim(bounce, DIM_BSDF_U)), rand(key, bounce_dim(bounce, DIM_BSDF_V)))
-        if pdf <= 0.0 or wr + wg + wb <= 0.0:
+        if (pdf <= 0.0 and not (label & LABEL_SINGULAR)) or wr + wg + wb <= 0.0:
             continue
         wix = wlx * tx + wly * bx + wlz * nsx
         wiy = wlx * ty + wly * by + wlz * nsy
@@ -528,23 +529,27 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         st.bounce[i] = bounce + 1
         if bounce + 1 > cfg[CFG_MAX_BOUNCE]:
             new_flags |= PF_TERMINATE
-        if label & LABEL_TRANSMIT:
+        if label & LABEL_REFLECT:
+            new_flags |= PF_REFLECT
+            if label & LABEL_DIFFUSE:
+                st.diffuse[i] += 1
+                if st.diffuse[i] > cfg[CFG_MAX_DIFFUSE]:
+                    new_flags |= PF_TERMINATE
+            else:
+                st.glossy[i] += 1
+                if st.glossy[i] > cfg[CFG_MAX_GLOSSY]:
+                    new_flags |= PF_TERMINATE
+        else:
             new_flags |= PF_TRANSMIT
             st.transmission[i] += 1
             if st.transmission[i] > cfg[CFG_MAX_TRANSMISSION]:
                 new_flags |= PF_TERMINATE
-        elif label & LABEL_DIFFUSE:
-            new_flags |= PF_DIFFUSE | PF_REFLECT
-            st.diffuse[i] += 1
-            if st.diffuse[i] > cfg[CFG_MAX_DIFFUSE]:
-                new_flags |= PF_TERMINATE
-        else:
-            new_flags |= PF_GLOSSY | PF_REFLECT
-            st.glossy[i] += 1
-            if st.glossy[i] > cfg[CFG_MAX_GLOSSY]:
-                new_flags |= PF_TERMINATE
-        if label & LABEL_SINGULAR:
-            new_flags |= PF_MIS_SKIP
+        if label & LABEL_DIFFUSE:
+            new_flags |= PF_DIFFUSE
+        elif label & LABEL_GLOSSY:
+            new_flags |= PF_GLOSSY
+        else:   # singular: a glossy ray for light visibility, no MIS at its hit
+            new_flags |= PF_GLOSSY | PF_MIS_SKIP
         st.flags[i] = new_flags
         st.mis_pdf[i] = pdf
         nox, noy, noz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)

@@ -111,17 +111,29 @@ class Geometry:
 
 @dataclass
 class Material:
-    """A surface shader reduced to the lobes the renderer knows.
+    """A surface shader reduced to the closures the renderer knows.
 
-    ``base_color`` is the diffuse reflectance (Lambert).  ``emission`` is the
-    emitted radiance (colour x strength), emitted on both sides like Cycles'
-    mesh lights.  Glossy and transmissive lobes will be added as new fields
-    with defaults that leave existing materials unchanged.
+    The BSDF is a sum of lobes, each weighted by a colour (all zero: the
+    surface only emits or is black):
+
+    * ``base_color``: Lambertian diffuse reflectance;
+    * ``mirror_color``: perfect mirror (Glossy BSDF at roughness 0);
+    * ``glass_color``: smooth dielectric with Fresnel reflection and
+      refraction (Glass BSDF at roughness 0), index ``ior``;
+    * ``refraction_color``: smooth refraction without reflection
+      (Refraction BSDF at roughness 0), index ``ior``.
+
+    ``emission`` is the emitted radiance (colour x strength), emitted on both
+    sides like Cycles' mesh lights.
     """
 
     name: str = "default"
     base_color: tuple = (0.8, 0.8, 0.8)
     emission: tuple = (0.0, 0.0, 0.0)
+    mirror_color: tuple = (0.0, 0.0, 0.0)
+    glass_color: tuple = (0.0, 0.0, 0.0)
+    refraction_color: tuple = (0.0, 0.0, 0.0)
+    ior: float = 1.5
 
 
 @dataclass
@@ -256,7 +268,9 @@ class SceneDescription:
         if not self.materials:
             raise SceneError("the scene needs at least one material")
         for m in self.materials:
-            for attr in ("base_color", "emission"):
+            if not (np.isfinite(m.ior) and m.ior > 0):
+                raise SceneError(f"material '{m.name}': ior must be positive, got {m.ior}")
+            for attr in ("base_color", "emission", "mirror_color", "glass_color", "refraction_color"):
                 v = np.asarray(getattr(m, attr), float)
                 if v.shape != (3,) or not np.all(np.isfinite(v)) or np.any(v < 0):
                     raise SceneError(f"material '{m.name}': {attr} must be 3 finite non-negative values")

@@ -86,12 +86,64 @@ def test_emission_shader(scene, fake_session):
 
 
 def test_other_shaders_fall_back_to_grey_diffuse(scene, fake_session):
-    mat = bpy.data.materials.new("Chrome")
-    replace_surface(mat, "ShaderNodeBsdfGlossy")
+    mat = bpy.data.materials.new("Velvet")
+    replace_surface(mat, "ShaderNodeBsdfSheen")
     m, warnings = exported(fake_session, mat)
     assert m.base_color == (0.8, 0.8, 0.8)
-    assert warnings == ["material 'Chrome': Glossy BSDF surface shader not supported yet; rendered as "
+    assert warnings == ["material 'Velvet': Sheen BSDF surface shader not supported yet; rendered as "
                         "Lambert diffuse with base colour (0.8, 0.8, 0.8)"]
+
+
+@pytest.mark.parametrize("bl_idname,attr", [("ShaderNodeBsdfAnisotropic", "mirror_color"),
+                                            ("ShaderNodeBsdfGlass", "glass_color"),
+                                            ("ShaderNodeBsdfRefraction", "refraction_color")])
+def test_sharp_glossy_glass_and_refraction(scene, fake_session, bl_idname, attr):
+    mat = bpy.data.materials.new("Sharp")
+    node = replace_surface(mat, bl_idname)
+    node.inputs["Color"].default_value = (0.9, 0.5, 0.25, 1.0)
+    node.inputs["Roughness"].default_value = 0.0
+    if "IOR" in node.inputs:
+        node.inputs["IOR"].default_value = 1.33
+    m, warnings = exported(fake_session, mat)
+    assert getattr(m, attr) == pytest.approx((0.9, 0.5, 0.25))
+    assert m.base_color == (0.0, 0.0, 0.0)
+    assert m.ior == pytest.approx(1.33 if attr != "mirror_color" else 1.5)
+    assert warnings == []
+
+
+def test_rough_glass_is_rendered_sharp_with_a_warning(scene, fake_session):
+    mat = bpy.data.materials.new("Frosted")
+    node = replace_surface(mat, "ShaderNodeBsdfGlass")
+    node.inputs["Roughness"].default_value = 0.3
+    m, warnings = exported(fake_session, mat)
+    assert m.glass_color == (1.0, 1.0, 1.0)
+    assert warnings == ["material 'Frosted': Glass BSDF Roughness 0.3 not supported yet; rendered as "
+                        "sharp glass of colour (1, 1, 1)"]
+
+
+def test_mix_and_add_shaders_sum_weighted_closures(scene, fake_session):
+    mat = bpy.data.materials.new("Mixed")
+    tree = mat.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (1.0, 0.0, 0.0, 1.0)
+    glossy = tree.nodes.new("ShaderNodeBsdfAnisotropic")   # "Glossy BSDF"
+    glossy.inputs["Roughness"].default_value = 0.0
+    emit = tree.nodes.new("ShaderNodeEmission")
+    emit.inputs["Strength"].default_value = 2.0
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs[0].default_value = 0.25
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(glossy.outputs[0], mix.inputs[2])
+    add = tree.nodes.new("ShaderNodeAddShader")
+    tree.links.new(mix.outputs[0], add.inputs[0])
+    tree.links.new(emit.outputs[0], add.inputs[1])
+    tree.links.new(add.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    m, warnings = exported(fake_session, mat)
+    assert m.base_color == pytest.approx((0.75, 0.0, 0.0))
+    assert m.mirror_color == pytest.approx((0.2, 0.2, 0.2))   # 0.25 x default colour 0.8
+    assert m.emission == pytest.approx((2.0, 2.0, 2.0))
+    assert warnings == []
 
 
 def test_empty_surface_is_black(scene, fake_session):

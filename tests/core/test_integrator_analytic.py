@@ -139,3 +139,56 @@ def test_time_limit_and_stop_keep_a_partial_image():
     assert np.all(np.isfinite(img)) and img[..., 0].mean() > 1.0
     mean, se = image_mean_and_se(s)
     assert abs(mean - 2.0) < 6 * se + 0.02   # unbiased so far (12 bounces: 2 - 2^-13)
+
+
+def _furnace_sphere(material, samples=8):
+    scene = _sky_sphere_scene(0.0, samples=samples)
+    scene.materials = [material]
+    scene.integrator.max_bounces = 64
+    scene.integrator.glossy_bounces = 64
+    scene.integrator.transmission_bounces = 64
+    return scene
+
+
+def test_clear_glass_sphere_in_a_furnace_is_invisible():
+    """Sharp glass of colour 1 neither absorbs nor emits: under a uniform sky every
+    path leaves with weight exactly 1, through any number of refractions and
+    internal reflections."""
+    s = render(_furnace_sphere(Material(base_color=(0, 0, 0), glass_color=(1, 1, 1), ior=1.5)))
+    assert np.all(np.abs(s.image()[..., :3] - 1.0) < 1e-5)
+    assert s.stats.nonfinite == 0
+
+
+def test_mirror_sphere_reflects_its_colour():
+    s = render(_furnace_sphere(Material(base_color=(0, 0, 0), mirror_color=(0.7, 0.5, 0.3))))
+    img = s.image()
+    assert np.all(np.abs(img[5:11, 5:11, 0] - 0.7) < 1e-5)
+    assert np.all(np.abs(img[5:11, 5:11, 2] - 0.3) < 1e-5)
+
+
+@pytest.mark.parametrize("ior", [1.5, 1.33])
+def test_glass_slab_reflectance_includes_internal_reflections(ior):
+    """A glass slab over a black floor under a white sky, seen from straight above.
+
+    One interface reflects F0 = ((n-1)/(n+1))^2 at normal incidence; a slab
+    with incoherent internal reflections reflects 2 F0 / (1 + F0) in total.
+    This needs the inverted IOR on the slab's back face.
+    """
+    from .scenes import grid_plane
+    top = grid_plane(50.0, z=0.0)
+    bottom = grid_plane(50.0, z=-0.1)[:, ::-1]       # faces down: the slab's outside
+    floor = grid_plane(50.0, z=-1.0)
+    geo = Geometry.from_triangles(np.concatenate([top, bottom, floor]),
+                                  material_index=np.array([0] * len(top) * 2 + [1] * len(floor)))
+    scene = SceneDescription(
+        geometry=geo,
+        materials=[Material(base_color=(0, 0, 0), glass_color=(1, 1, 1), ior=ior),
+                   Material(base_color=(0, 0, 0))],
+        camera=Camera(matrix_world=translation(0, 0, 5), type="ORTHO", ortho_scale=0.01),
+        world=World(color=(1.0, 1.0, 1.0)),
+        film=Film(width=32, height=32, filter_type="BOX", filter_width=1.0),
+        integrator=Integrator(samples=1024, max_bounces=64, glossy_bounces=64,
+                              transmission_bounces=64))
+    f0 = ((ior - 1) / (ior + 1)) ** 2
+    # Every sample is 0 or 1: the standard error is sqrt(R(1-R)/N), about 0.5 %.
+    assert_mean(render(scene), 2 * f0 / (1 + f0), max_rel_se=0.006)

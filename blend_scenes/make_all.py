@@ -21,6 +21,7 @@ SCENES = (
     "light_area",
     "light_emissive_mesh",
     "world_color",
+    "glass_mirror",
 )
 
 

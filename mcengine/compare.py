@@ -81,10 +81,11 @@ FLOAT_TOLERANCE_ABS = 1e-8
 # cancelling lgamma terms (1e-8 relative at 1e8 dof).
 DOF_NORMAL = 1e7
 
-# A correlation factor this far above 1 (4 standard deviations of its noise at
-# K = 2) means the renders' pixels are not independent: the summary says so,
-# since a denoiser left on is the usual cause.
-CORRELATION_WARNING = 1.5
+# A correlation factor more than this many of its standard deviations above 1
+# means the renders' pixels are not independent: the summary says so, since a
+# denoiser left on is the usual cause.  (At K = 2 on a 128x128 Cornell box
+# the factor's standard deviation is about 0.2.)
+CORRELATION_WARNING_SIGMAS = 4.0
 
 # Incomplete-beta continued fraction: relative convergence tolerance (double
 # precision) and a cap on iterations far above the few hundred it needs.
@@ -436,6 +437,8 @@ def _stack_moments(stack: np.ndarray, ey: np.ndarray, ex: np.ndarray):
         variances are multiplied by ``max(1, block)``, frame variances by
         ``max(1, block, lag)``: the lag factor also counts the pairs that
         block edges cut.
+    corr_dof : float
+        Degrees of freedom of the block factor (relative variance ``2 / dof``).
     """
     k = stack.shape[0]
     pixel_mean = stack.mean(axis=0)
@@ -469,7 +472,7 @@ def _stack_moments(stack: np.ndarray, ey: np.ndarray, ex: np.ndarray):
                                        ex[:-1], axis=1) > 0
     blocks = moments(_block_sums(pixel_mean, ey, ex), var_sum,
                      _block_sums(pixel_var**2, ey, ex), counts, noisy_blocks, block_inflation)
-    return frame, blocks, np.array([block_corr, lag_corr])
+    return frame, blocks, np.array([block_corr, lag_corr]), corr_dof
 
 
 @dataclass
@@ -543,6 +546,7 @@ class Agreement:
     correlation         (2, 2) pixel correlation factors, rows a and b, columns
                         block scale (measured) and frame scale (from lags up
                         to MAX_CORRELATION_LAG); 1 = independent pixels
+    correlation_dof     (2,) degrees of freedom of a's and b's block factor
     edges_y, edges_x    (gy + 1,), (gx + 1,) int block edges in pixels
     frame_mean_a/_b     (3,) frame means
     frame_se_a/_b       (3,) their standard errors
@@ -565,6 +569,7 @@ class Agreement:
     n_tests: int
     n_skipped: int
     correlation: np.ndarray
+    correlation_dof: np.ndarray
     edges_y: np.ndarray
     edges_x: np.ndarray
     frame_mean_a: np.ndarray
@@ -595,6 +600,12 @@ class Agreement:
     def block_rejected(self) -> np.ndarray:
         """(gy, gx, 3) bool: block channels that differ."""
         return np.nan_to_num(self.block_p_holm, nan=1.0) <= self.alpha
+
+    @property
+    def pixels_correlated(self) -> bool:
+        """True if either stack's pixels are measurably not independent."""
+        sd = np.sqrt(2.0 / self.correlation_dof)
+        return bool(np.any(self.correlation.max(axis=1) > 1.0 + CORRELATION_WARNING_SIGMAS * sd))
 
     @property
     def share_blocks_differ(self) -> float:
@@ -633,13 +644,14 @@ class Agreement:
                 f"K={self.seeds[0]}/{self.seeds[1]}, pixel correlation "
                 f"{self.correlation[0].max():.2f}/{self.correlation[1].max():.2f}"
                 + (" (pixels not independent: denoiser or splatting filter on?)"
-                   if self.correlation.max() > CORRELATION_WARNING else ""))
+                   if self.pixels_correlated else ""))
 
     def to_dict(self) -> dict:
         """Plain JSON-ready dict of every field plus ``differing_blocks``,
         ``share_blocks_differ`` and ``summary`` (NaN and inf become None)."""
         out = {name: getattr(self, name) for name in self.__dataclass_fields__}
         out.update(frame_rejected=self.frame_rejected, block_rejected=self.block_rejected,
+                   pixels_correlated=self.pixels_correlated,
                    share_blocks_differ=self.share_blocks_differ,
                    differing_blocks=self.differing_blocks(), summary=self.summary())
         return _jsonable(out)
@@ -702,8 +714,8 @@ def compare_stacks(a, b, grid=(8, 8), alpha: float = 1e-3,
         raise ValueError(f"image {w}x{h} is smaller than the {grid[1]}x{grid[0]} block grid")
     ey, ex = block_edges(h, grid[0]), block_edges(w, grid[1])
 
-    frame_a, blocks_a, corr_a = _stack_moments(a, ey, ex)
-    frame_b, blocks_b, corr_b = _stack_moments(b, ey, ex)
+    frame_a, blocks_a, corr_a, corr_dof_a = _stack_moments(a, ey, ex)
+    frame_b, blocks_b, corr_b, corr_dof_b = _stack_moments(b, ey, ex)
     frame, blocks = _two_sample(frame_a, frame_b), _two_sample(blocks_a, blocks_b)
 
     p_all = np.concatenate([frame.p.ravel(), blocks.p.ravel()])
@@ -723,6 +735,7 @@ def compare_stacks(a, b, grid=(8, 8), alpha: float = 1e-3,
         verdict=verdict, alpha=alpha, confidence=confidence, shape=(h, w),
         seeds=(a.shape[0], b.shape[0]), n_tests=int(tested.sum()),
         n_skipped=int((~tested).sum()), correlation=np.stack([corr_a, corr_b]),
+        correlation_dof=np.array([corr_dof_a, corr_dof_b]),
         edges_y=ey, edges_x=ex,
         frame_mean_a=frame_a.mean, frame_mean_b=frame_b.mean,
         frame_se_a=np.sqrt(frame_a.var), frame_se_b=np.sqrt(frame_b.var),

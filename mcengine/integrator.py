@@ -203,9 +203,9 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     return n
 
 
-# -- helpers ---------------------------------------------------------------------------------
+# -- helpers shared by every integrator ----------------------------------------------------
 @device
-def _clamp(r, g, b, limit, stats):
+def clamp_light(r, g, b, limit, stats):
     """Cycles' film_clamp_light: drop non-finite values, cap |r|+|g|+|b| at limit."""
     if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
         stats[ST_NONFINITE] += 1
@@ -220,14 +220,14 @@ def _clamp(r, g, b, limit, stats):
 @device
 def _add(st, i, r, g, b, direct, fcfg, stats):
     limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
-    r, g, b = _clamp(r, g, b, limit, stats)
+    r, g, b = clamp_light(r, g, b, limit, stats)
     st.radiance[i, 0] += r
     st.radiance[i, 1] += g
     st.radiance[i, 2] += b
 
 
 @device
-def _lamp_visible_to_ray(flags, lamp_flags):
+def lamp_visible_to_ray(flags, lamp_flags):
     """Cycles' is_light_shader_visible_to_path for a ray of the given path flags."""
     if flags & PF_CAMERA:
         return (lamp_flags & LF_VIS_CAMERA) != 0
@@ -243,7 +243,7 @@ def _lamp_visible_to_ray(flags, lamp_flags):
 
 
 @device
-def _nee_exclude(lamp_flags):
+def nee_exclude(lamp_flags):
     """BSDF lobes a light must not illuminate (its ray-visibility switches)."""
     ex = 0
     if not (lamp_flags & LF_VIS_DIFFUSE):
@@ -256,7 +256,7 @@ def _nee_exclude(lamp_flags):
 
 
 @device
-def _set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
+def set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
     st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2] = ox, oy, oz
     st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2] = dx, dy, dz
     st.ray_tmax[i] = tmax
@@ -265,126 +265,301 @@ def _set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
     st.t32[i] = min(tmax, T_INFINITE)
 
 
-# -- 3. shading ------------------------------------------------------------------------------
+@device
+def skip_self_hit(st, i, sc, p, stats):
+    """Handle a spurious re-hit of the triangle the ray left; True if it was one.
+
+    Triangles are flat, so a ray leaving one can only hit it again through
+    rounding: the ray continues from just past that hit.
+    """
+    if p < 0 or p != st.self_prim[i]:
+        return False
+    stats[ST_SELF_HITS] += 1
+    ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
+    dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
+    if not math.isfinite(t) or t < 0.0:
+        t = 0.0
+    s = offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
+    set_ray(st, i, ox + (t + s) * dx, oy + (t + s) * dy, oz + (t + s) * dz, dx, dy, dz,
+            st.ray_tmax[i] - t - s)
+    return True
+
+
+@device
+def hit_distance(st, i, sc, p):
+    """(t, b1, b2) of the ray's hit on triangle p (t = ray_tmax if p < 0)."""
+    if p < 0:
+        return st.ray_tmax[i], 0.0, 0.0
+    t, b1, b2 = intersect_prim(st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2],
+                               st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2], sc.verts, sc.tris, p)
+    return (t if (math.isfinite(t) and t > 0.0) else 0.0), b1, b2
+
+
+@device
+def surface_geometry(sc, p, b1, b2, dx, dy, dz):
+    """Hit point, geometric and shading normals facing the ray, and the side hit.
+
+    Returns ``(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing)``.
+    All BSDFs are two-sided, so both normals are turned towards the incoming
+    ray; ``backfacing`` records that the ray came from the inside (relative to
+    the winding, or to the shading normals where they disagree with it).
+    """
+    b0 = 1.0 - b1 - b2
+    va, vb, vc = sc.tris[p, 0], sc.tris[p, 1], sc.tris[p, 2]
+    hx = b0 * sc.verts[va, 0] + b1 * sc.verts[vb, 0] + b2 * sc.verts[vc, 0]
+    hy = b0 * sc.verts[va, 1] + b1 * sc.verts[vb, 1] + b2 * sc.verts[vc, 1]
+    hz = b0 * sc.verts[va, 2] + b1 * sc.verts[vb, 2] + b2 * sc.verts[vc, 2]
+    ngx, ngy, ngz = sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2]
+    nsx = b0 * sc.normals[p, 0, 0] + b1 * sc.normals[p, 1, 0] + b2 * sc.normals[p, 2, 0]
+    nsy = b0 * sc.normals[p, 0, 1] + b1 * sc.normals[p, 1, 1] + b2 * sc.normals[p, 2, 1]
+    nsz = b0 * sc.normals[p, 0, 2] + b1 * sc.normals[p, 1, 2] + b2 * sc.normals[p, 2, 2]
+    ln = math.sqrt(nsx * nsx + nsy * nsy + nsz * nsz)
+    if ln > 0.0 and math.isfinite(ln):
+        nsx, nsy, nsz = nsx / ln, nsy / ln, nsz / ln
+        if nsx * ngx + nsy * ngy + nsz * ngz < 0.0:
+            # Shading normals on the other side than the winding says: trust
+            # the normals (mirrored instances, flipped faces).
+            ngx, ngy, ngz = -ngx, -ngy, -ngz
+    else:
+        nsx, nsy, nsz = ngx, ngy, ngz
+    cos_o_geo = -(dx * ngx + dy * ngy + dz * ngz)
+    backfacing = cos_o_geo < 0.0
+    if backfacing:
+        ngx, ngy, ngz = -ngx, -ngy, -ngz
+        nsx, nsy, nsz = -nsx, -nsy, -nsz
+        cos_o_geo = -cos_o_geo
+    return hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing
+
+
+@device
+def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_light,
+                     transparent_left):
+    """Light from lamps the ray passes through before t_hit (lamps do not block rays).
+
+    Lamps are visited nearest first; each one counts as a transparent bounce
+    (Cycles), at most ``transparent_left`` of them.  MIS weights use the NEE
+    pdf of the lamp: its selection probability times the solid-angle pdf, or
+    the solid-angle pdf alone when every light is sampled (``every_light``).
+    Returns ``(r, g, b, lamps_passed)``, unweighted by the path throughput.
+    """
+    lr_sum = lg_sum = lb_sum = 0.0
+    passed = 0
+    last_t = 0.0
+    n_lamps = sc.lamps.shape[0]
+    more = True
+    while more and passed < transparent_left:
+        best_t = t_hit
+        best = -1
+        n_hits = 0
+        br = bg = bb = bpdf = 0.0
+        for li in range(n_lamps):
+            if not lamp_visible_to_ray(flags, int(sc.lamps[li, L_FLAGS])):
+                continue
+            tl, lr, lg, lb, lpdf = intersect_lamp(sc.lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
+            if tl > last_t and tl < t_hit:
+                n_hits += 1
+                if tl < best_t:
+                    best_t, best = tl, li
+                    br, bg, bb, bpdf = lr, lg, lb, lpdf
+        if best < 0:
+            break
+        w = 1.0
+        if not (flags & PF_MIS_SKIP):
+            pmf = 1.0 if every_light else sc.lamps[best, L_PMF]
+            w = power_heuristic(mis_pdf, pmf * bpdf)
+        lr_sum += br * w
+        lg_sum += bg * w
+        lb_sum += bb * w
+        passed += 1
+        last_t = best_t
+        more = n_hits > 1
+    return lr_sum, lg_sum, lb_sum, passed
+
+
+@device
+def sun_light(sc, dx, dy, dz, flags, mis_pdf, every_light):
+    """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
+    r = g = b = 0.0
+    for li in range(sc.lamps.shape[0]):
+        if int(sc.lamps[li, L_TYPE]) != LT_SUN or sc.lamps[li, L_SUN_COS] >= 1.0:
+            continue
+        lflags = int(sc.lamps[li, L_FLAGS])
+        if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):
+            continue
+        lr, lg, lb, lpdf = sun_radiance(sc.lamps, li, dx, dy, dz)
+        if lpdf > 0.0:
+            w = 1.0
+            if not (flags & PF_MIS_SKIP):
+                pmf = 1.0 if every_light else sc.lamps[li, L_PMF]
+                w = power_heuristic(mis_pdf, pmf * lpdf)
+            r += lr * w
+            g += lg * w
+            b += lb * w
+    return r, g, b
+
+
+@device
+def emission_weight(sc, p, t_hit, cos_o_geo, flags, mis_pdf, emit_pmf_scale):
+    """MIS weight of emission found by a BSDF ray on emissive triangle p."""
+    if flags & PF_MIS_SKIP:
+        return 1.0
+    j = sc.tri_light[p]
+    if j < 0:
+        return 1.0
+    light_pdf = sc.emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (sc.tri_area[p] * cos_o_geo)
+    return power_heuristic(mis_pdf, light_pdf)
+
+
+@device
+def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2):
+    """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h.
+
+    ``pmf`` is the probability with which the caller chose this light.
+    Returns ``(wix, wiy, wiz, dist, Lr, Lg, Lb, pdf, use_mis, cast_shadow,
+    exclude, lnx, lny, lnz)``: the direction and distance to the light point,
+    the radiance divided by the sampling pdf (pmf included), the solid-angle
+    pdf (0 for delta lights, which get no MIS), the light's flags, and the
+    emitter's unit normal (zero for lamps) for offsetting the shadow ray's end.
+    All-zero radiance means no contribution.
+    """
+    n_lamps = sc.lamps.shape[0]
+    if idx < n_lamps:
+        lflags = int(sc.lamps[idx, L_FLAGS])
+        if bounce > sc.lamps[idx, L_MAX_BOUNCES]:
+            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
+        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(sc.lamps, idx, hx, hy, hz, u1, u2)
+        use_mis = (lflags & LF_USE_MIS) != 0
+        if pdf > 0.0:
+            pdf_l = pmf * pdf
+            lr, lg, lb = lr / pdf_l, lg / pdf_l, lb / pdf_l
+        else:   # delta light: L is already the L/pdf term
+            pdf_l = 0.0
+            use_mis = False
+            lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
+        return (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, (lflags & LF_CAST_SHADOW) != 0,
+                nee_exclude(lflags), 0.0, 0.0, 0.0)
+    tri = sc.emit_tri[idx - n_lamps]
+    qx, qy, qz = sample_triangle_point(sc.verts, sc.tris, tri, u1, u2)
+    lx, ly, lz = qx - hx, qy - hy, qz - hz
+    d2 = lx * lx + ly * ly + lz * lz
+    dist = math.sqrt(d2)
+    if dist <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
+    wix, wiy, wiz = lx / dist, ly / dist, lz / dist
+    lnx, lny, lnz = sc.tri_normal[tri, 0], sc.tri_normal[tri, 1], sc.tri_normal[tri, 2]
+    cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
+    if cos_l <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
+    pdf_l = pmf * d2 / (sc.tri_area[tri] * cos_l)
+    em = sc.mat_index[tri]
+    return (wix, wiy, wiz, dist, sc.materials[em, M_EMISSION] / pdf_l,
+            sc.materials[em, M_EMISSION + 1] / pdf_l, sc.materials[em, M_EMISSION + 2] / pdf_l,
+            pdf_l, True, True, 0, lnx, lny, lnz)
+
+
+@device
+def push_shadow(sq, n_shadow, owner, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, dist,
+                lnx, lny, lnz, cr, cg, cb):
+    """Queue a shadow ray from h towards the light point; returns the new queue length.
+
+    Both ends leave their surfaces (pbrt's SpawnRayTo): the direction is
+    re-aimed from the offset origin at the offset target, else at grazing
+    angles the shifted ray meets the emitter's plane before its end.
+    """
+    sox, soy, soz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
+    sdx, sdy, sdz = wix, wiy, wiz
+    tmax = T_INFINITE
+    if not math.isinf(dist):
+        ex, ey, ez = hx + dist * wix, hy + dist * wiy, hz + dist * wiz
+        if lnx != 0.0 or lny != 0.0 or lnz != 0.0:
+            ex, ey, ez = offset_origin(ex, ey, ez, lnx, lny, lnz, -wix, -wiy, -wiz)
+        sdx, sdy, sdz = ex - sox, ey - soy, ez - soz
+        length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
+        sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
+        tmax = length * (1.0 - SHADOW_SHORTEN)
+    sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
+    sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = sdx, sdy, sdz
+    sq.t32[n_shadow] = tmax
+    sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
+    sq.path[n_shadow] = owner
+    return n_shadow + 1
+
+
+@device
+def local_frame(nsx, nsy, nsz, dx, dy, dz):
+    """Tangent frame around the shading normal and wo = -d in it."""
+    tx, ty, tz, bx, by, bz = orthonormal_basis(nsx, nsy, nsz)
+    wox = -(dx * tx + dy * ty + dz * tz)
+    woy = -(dx * bx + dy * by + dz * bz)
+    woz = -(dx * nsx + dy * nsy + dz * nsz)
+    return tx, ty, tz, bx, by, bz, wox, woy, woz
+
+
+@device
+def next_path_flags(flags, label):
+    """Path flags after a BSDF sample with ``label`` (Cycles' path_state_next)."""
+    new = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_DIFFUSE |
+                    PF_GLOSSY | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
+    new |= PF_REFLECT if label & LABEL_REFLECT else PF_TRANSMIT
+    if label & LABEL_DIFFUSE:
+        new |= PF_DIFFUSE
+    elif label & LABEL_GLOSSY:
+        new |= PF_GLOSSY
+    else:   # singular: a glossy ray for light visibility, no MIS at its hit
+        new |= PF_GLOSSY | PF_MIS_SKIP
+    return new
+
+
+# -- 3. shading (path tracing) -------------------------------------------------------------
 @kernel
 def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
-    """Shade the hits of the n live rays; returns the number of queued shadow rays."""
+    """Shade the hits of the n live paths; returns the number of queued shadow rays."""
     n_shadow = 0
     n_lamps = sc.lamps.shape[0]
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
     for i in range(n):
-        flags = st.flags[i]
-        ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
-        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
-        p = prim[i]
         st.alive[i] = 0
-
-        # Spurious re-hit of the triangle the ray left (possible only through
-        # rounding, triangles being flat): continue from just past it.
-        if p >= 0 and p == st.self_prim[i]:
-            stats[ST_SELF_HITS] += 1
-            t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
-            if not math.isfinite(t) or t < 0.0:
-                t = 0.0
-            s = offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
-            _set_ray(st, i, ox + (t + s) * dx, oy + (t + s) * dy, oz + (t + s) * dz, dx, dy, dz,
-                     st.ray_tmax[i] - t - s)
+        p = prim[i]
+        if skip_self_hit(st, i, sc, p, stats):
             st.alive[i] = 1
             continue
-
-        t_hit = st.ray_tmax[i]
-        b1 = b2 = 0.0
-        if p >= 0:
-            t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
-            t_hit = t if (math.isfinite(t) and t > 0.0) else 0.0
+        flags = st.flags[i]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        t_hit, b1, b2 = hit_distance(st, i, sc, p)
         arrival_direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
 
-        # -- lamps along the ray (they do not block it) --------------------------------
+        # -- lamps along the ray ---------------------------------------------------------
         if lamps_hit:
-            last_t = 0.0
-            more = True
-            while more:
-                # The nearest lamp beyond last_t (lamps are few; rays pass through
-                # them); another pass only if this one saw several.
-                best_t = t_hit
-                best = -1
-                n_hits = 0
-                br = bg = bb = bpdf = 0.0
-                for li in range(n_lamps):
-                    if not _lamp_visible_to_ray(flags, int(sc.lamps[li, L_FLAGS])):
-                        continue
-                    tl, lr, lg, lb, lpdf = intersect_lamp(sc.lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
-                    if tl > last_t and tl < t_hit:
-                        n_hits += 1
-                        if tl < best_t:
-                            best_t, best = tl, li
-                            br, bg, bb, bpdf = lr, lg, lb, lpdf
-                if best < 0:
-                    break
-                more = n_hits > 1
-                w = 1.0
-                if not (flags & PF_MIS_SKIP):
-                    w = power_heuristic(st.mis_pdf[i], sc.lamps[best, L_PMF] * bpdf)
-                _add(st, i, st.beta[i, 0] * br * w, st.beta[i, 1] * bg * w, st.beta[i, 2] * bb * w,
+            lr, lg, lb, passed = lamps_on_segment(
+                sc, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2], dx, dy, dz, t_hit, flags,
+                st.mis_pdf[i], False, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+            if passed:
+                _add(st, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                      arrival_direct, fcfg, stats)
-                last_t = best_t
-                st.transparent[i] += 1
+                st.transparent[i] += passed
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
-                    p = -2   # terminate after the lamp's light
-                    break
-            if p == -2:
-                continue
+                    continue   # Cycles: the path ends after the lamp's light
 
-        # -- escaped: world and suns ---------------------------------------------------
+        # -- escaped: world and suns -------------------------------------------------------
         if p < 0:
             if flags & PF_TRANSPARENT_BG:
                 st.transparency[i] = 1.0
             elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
                 _add(st, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
                      st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
-            for li in range(n_lamps):
-                if int(sc.lamps[li, L_TYPE]) != LT_SUN or sc.lamps[li, L_SUN_COS] >= 1.0:
-                    continue
-                lflags = int(sc.lamps[li, L_FLAGS])
-                if not (lflags & LF_USE_MIS) or not _lamp_visible_to_ray(flags, lflags):
-                    continue
-                lr, lg, lb, lpdf = sun_radiance(sc.lamps, li, dx, dy, dz)
-                if lpdf > 0.0:
-                    w = 1.0
-                    if not (flags & PF_MIS_SKIP):
-                        w = power_heuristic(st.mis_pdf[i], sc.lamps[li, L_PMF] * lpdf)
-                    _add(st, i, st.beta[i, 0] * lr * w, st.beta[i, 1] * lg * w,
-                         st.beta[i, 2] * lb * w, arrival_direct, fcfg, stats)
+            if n_lamps:
+                lr, lg, lb = sun_light(sc, dx, dy, dz, flags, st.mis_pdf[i], False)
+                if lr + lg + lb > 0.0:
+                    _add(st, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
+                         arrival_direct, fcfg, stats)
             continue
 
-        # -- surface hit ---------------------------------------------------------------
+        # -- surface hit ---------------------------------------------------------------------
         if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
-        b0 = 1.0 - b1 - b2
-        va, vb, vc = sc.tris[p, 0], sc.tris[p, 1], sc.tris[p, 2]
-        hx = b0 * sc.verts[va, 0] + b1 * sc.verts[vb, 0] + b2 * sc.verts[vc, 0]
-        hy = b0 * sc.verts[va, 1] + b1 * sc.verts[vb, 1] + b2 * sc.verts[vc, 1]
-        hz = b0 * sc.verts[va, 2] + b1 * sc.verts[vb, 2] + b2 * sc.verts[vc, 2]
-        ngx, ngy, ngz = sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2]
-        nsx = b0 * sc.normals[p, 0, 0] + b1 * sc.normals[p, 1, 0] + b2 * sc.normals[p, 2, 0]
-        nsy = b0 * sc.normals[p, 0, 1] + b1 * sc.normals[p, 1, 1] + b2 * sc.normals[p, 2, 1]
-        nsz = b0 * sc.normals[p, 0, 2] + b1 * sc.normals[p, 1, 2] + b2 * sc.normals[p, 2, 2]
-        ln = math.sqrt(nsx * nsx + nsy * nsy + nsz * nsz)
-        if ln > 0.0 and math.isfinite(ln):
-            nsx, nsy, nsz = nsx / ln, nsy / ln, nsz / ln
-            if nsx * ngx + nsy * ngy + nsz * ngz < 0.0:
-                # Shading normal on the other side of the triangle than its
-                # winding: treat the winding as wrong (e.g. mirrored instances).
-                ngx, ngy, ngz = -ngx, -ngy, -ngz
-        else:
-            nsx, nsy, nsz = ngx, ngy, ngz
-        # All BSDFs are two-sided: face the normals towards the incoming ray.
-        cos_o_geo = -(dx * ngx + dy * ngy + dz * ngz)
-        backfacing = cos_o_geo < 0.0     # arrived from inside: glass inverts its IOR
-        if backfacing:
-            ngx, ngy, ngz = -ngx, -ngy, -ngz
-            nsx, nsy, nsz = -nsx, -nsy, -nsz
-            cos_o_geo = -cos_o_geo
+        hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing = surface_geometry(
+            sc, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
 
         # Russian roulette (Cycles: from the third vertex on, with the
@@ -395,12 +570,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # Emission (two-sided).
         if sc.materials[m, M_EMISSIVE] > 0.0:
-            w = 1.0
-            if not (flags & PF_MIS_SKIP):
-                j = sc.tri_light[p]
-                if j >= 0:
-                    light_pdf = sc.emit_pmf[j] * t_hit * t_hit / (sc.tri_area[p] * cos_o_geo)
-                    w = power_heuristic(st.mis_pdf[i], light_pdf)
+            w = emission_weight(sc, p, t_hit, cos_o_geo, flags, st.mis_pdf[i], 1.0)
             _add(st, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
                  st.beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
                  st.beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
@@ -415,98 +585,36 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             st.beta[i, 0] /= q
             st.beta[i, 1] /= q
             st.beta[i, 2] /= q
+        tx, ty, tz, bx, by, bz, wox, woy, woz = local_frame(nsx, nsy, nsz, dx, dy, dz)
 
-        # Local shading frame.
-        tx, ty, tz, bx, by, bz = orthonormal_basis(nsx, nsy, nsz)
-        wox = -(dx * tx + dy * ty + dz * tz)
-        woy = -(dx * bx + dy * by + dz * bz)
-        woz = -(dx * nsx + dy * nsy + dz * nsz)
-        nee_direct = bounce == 0
-
-        # -- next-event estimation -------------------------------------------------------
+        # -- next-event estimation: one light, picked by power ---------------------------------
         if cfg[CFG_LIGHTS]:
             idx = pick_light(sc.light_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_PICK)))
-            u1 = rand(key, bounce_dim(bounce, DIM_LIGHT_U))
-            u2 = rand(key, bounce_dim(bounce, DIM_LIGHT_V))
-            lr = lg = lb = 0.0
-            wix = wiy = wiz = 0.0
-            lnx = lny = lnz = 0.0   # unit normal at the light point (emissive triangles)
-            pdf_l = 0.0
-            dist = 0.0
-            use_mis = True
-            cast_shadow = True
-            exclude = 0
-            if idx < n_lamps:
-                lflags = int(sc.lamps[idx, L_FLAGS])
-                if bounce <= sc.lamps[idx, L_MAX_BOUNCES]:
-                    wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(sc.lamps, idx, hx, hy, hz, u1, u2)
-                    pmf = sc.lamps[idx, L_PMF]
-                    use_mis = (lflags & LF_USE_MIS) != 0
-                    cast_shadow = (lflags & LF_CAST_SHADOW) != 0
-                    exclude = _nee_exclude(lflags)
-                    if pdf > 0.0:
-                        pdf_l = pmf * pdf
-                        lr, lg, lb = lr / pdf_l, lg / pdf_l, lb / pdf_l
-                    else:   # delta light: L is already the L/pdf term
-                        use_mis = False
-                        lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
-            else:
-                j = idx - n_lamps
-                tri = sc.emit_tri[j]
-                qx, qy, qz = sample_triangle_point(sc.verts, sc.tris, tri, u1, u2)
-                lx, ly, lz = qx - hx, qy - hy, qz - hz
-                d2 = lx * lx + ly * ly + lz * lz
-                dist = math.sqrt(d2)
-                if dist > 0.0:
-                    wix, wiy, wiz = lx / dist, ly / dist, lz / dist
-                    lnx, lny, lnz = sc.tri_normal[tri, 0], sc.tri_normal[tri, 1], sc.tri_normal[tri, 2]
-                    cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
-                    if cos_l > 0.0:
-                        pdf_l = sc.emit_pmf[j] * d2 / (sc.tri_area[tri] * cos_l)
-                        em = sc.mat_index[tri]
-                        lr = sc.materials[em, M_EMISSION] / pdf_l
-                        lg = sc.materials[em, M_EMISSION + 1] / pdf_l
-                        lb = sc.materials[em, M_EMISSION + 2] / pdf_l
-            if lr + lg + lb > 0.0 and dist > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
-                wlx = wix * tx + wiy * ty + wiz * tz
-                wly = wix * bx + wiy * by + wiz * bz
-                wlz = wix * nsx + wiy * nsy + wiz * nsz
-                fr, fg, fb, bsdf_pdf = bsdf_eval(sc.materials, m, wox, woy, woz, wlx, wly, wlz, exclude)
+            pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
+            (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
+             lnx, lny, lnz) = sample_light(sc, idx, pmf, hx, hy, hz, bounce,
+                                           rand(key, bounce_dim(bounce, DIM_LIGHT_U)),
+                                           rand(key, bounce_dim(bounce, DIM_LIGHT_V)))
+            if lr + lg + lb > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
+                fr, fg, fb, bsdf_pdf = bsdf_eval(
+                    sc.materials, m, wox, woy, woz, wix * tx + wiy * ty + wiz * tz,
+                    wix * bx + wiy * by + wiz * bz, wix * nsx + wiy * nsy + wiz * nsz, exclude)
                 w = power_heuristic(pdf_l, bsdf_pdf) if use_mis else 1.0
                 cr = st.beta[i, 0] * fr * lr * w
                 cg = st.beta[i, 1] * fg * lg * w
                 cb = st.beta[i, 2] * fb * lb * w
                 if cr + cg + cb > 0.0:
-                    limit = fcfg[FCFG_CLAMP_DIRECT] if nee_direct else fcfg[FCFG_CLAMP_INDIRECT]
-                    cr, cg, cb = _clamp(cr, cg, cb, limit, stats)
+                    limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
+                    cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
                     if cast_shadow:
-                        # Both ends leave their surfaces (pbrt's SpawnRayTo): the
-                        # direction is re-aimed from the offset origin at the
-                        # offset target, else at grazing angles the shifted ray
-                        # reaches the emitter's plane before tmax.
-                        sox, soy, soz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
-                        sdx, sdy, sdz = wix, wiy, wiz
-                        tmax = T_INFINITE
-                        if not math.isinf(dist):
-                            ex, ey, ez = hx + dist * wix, hy + dist * wiy, hz + dist * wiz
-                            if lnx != 0.0 or lny != 0.0 or lnz != 0.0:
-                                ex, ey, ez = offset_origin(ex, ey, ez, lnx, lny, lnz, -wix, -wiy, -wiz)
-                            sdx, sdy, sdz = ex - sox, ey - soy, ez - soz
-                            length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
-                            sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
-                            tmax = length * (1.0 - SHADOW_SHORTEN)
-                        sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
-                        sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = sdx, sdy, sdz
-                        sq.t32[n_shadow] = tmax
-                        sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
-                        sq.path[n_shadow] = i
-                        n_shadow += 1
+                        n_shadow = push_shadow(sq, n_shadow, i, hx, hy, hz, ngx, ngy, ngz,
+                                               wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb)
                     else:
                         st.radiance[i, 0] += cr
                         st.radiance[i, 1] += cg
                         st.radiance[i, 2] += cb
 
-        # -- BSDF sampling: the next ray ---------------------------------------------------
+        # -- BSDF sampling: the next ray ---------------------------------------------------------
         wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
             sc.materials, m, wox, woy, woz, backfacing, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
             rand(key, bounce_dim(bounce, DIM_BSDF_U)), rand(key, bounce_dim(bounce, DIM_BSDF_V)))
@@ -524,13 +632,11 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # Bounce counting (Cycles' path_state_next): a limit reached here
         # lets the next vertex collect emission only.
-        new_flags = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_DIFFUSE |
-                              PF_GLOSSY | PF_TRANSMIT | PF_REFLECT)
+        new_flags = next_path_flags(flags, label)
         st.bounce[i] = bounce + 1
         if bounce + 1 > cfg[CFG_MAX_BOUNCE]:
             new_flags |= PF_TERMINATE
         if label & LABEL_REFLECT:
-            new_flags |= PF_REFLECT
             if label & LABEL_DIFFUSE:
                 st.diffuse[i] += 1
                 if st.diffuse[i] > cfg[CFG_MAX_DIFFUSE]:
@@ -540,20 +646,13 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                 if st.glossy[i] > cfg[CFG_MAX_GLOSSY]:
                     new_flags |= PF_TERMINATE
         else:
-            new_flags |= PF_TRANSMIT
             st.transmission[i] += 1
             if st.transmission[i] > cfg[CFG_MAX_TRANSMISSION]:
                 new_flags |= PF_TERMINATE
-        if label & LABEL_DIFFUSE:
-            new_flags |= PF_DIFFUSE
-        elif label & LABEL_GLOSSY:
-            new_flags |= PF_GLOSSY
-        else:   # singular: a glossy ray for light visibility, no MIS at its hit
-            new_flags |= PF_GLOSSY | PF_MIS_SKIP
         st.flags[i] = new_flags
         st.mis_pdf[i] = pdf
         nox, noy, noz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
-        _set_ray(st, i, nox, noy, noz, wix, wiy, wiz, math.inf)
+        set_ray(st, i, nox, noy, noz, wix, wiy, wiz, math.inf)
         st.self_prim[i] = p
         st.alive[i] = 1
     return n_shadow

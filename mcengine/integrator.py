@@ -47,6 +47,7 @@ from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_FILTER_X, DIM_
 PathState = namedtuple("PathState", [
     "key",           # (B,) uint64   RNG key of the path sample
     "pixel",         # (B,) int32    film pixel (index into the film region)
+    "root",          # (B,) int32    camera sample a ray belongs to (classic integrators)
     "ray_o",         # (B, 3) f64    ray origin
     "ray_d",         # (B, 3) f64    unit ray direction
     "ray_tmax",      # (B,) f64      ray length (far clip for camera rays)
@@ -83,6 +84,7 @@ SceneData = namedtuple("SceneData", [
     "light_cdf",     # (NL + NE + 1,) f64  NEE light distribution
     "emit_tri",      # (NE,) int32  emissive triangle ids
     "emit_pmf",      # (NE,) f64    their NEE probabilities
+    "emit_cdf",      # (NE + 1,) f64  distribution over emissive triangles alone
     "tri_light",     # (T,) int32   index into emit_tri, or -1
     "tri_area",      # (T,) f64
     "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
@@ -136,7 +138,7 @@ ST_SIZE = 5
 def alloc_path_state(n: int) -> PathState:
     """Buffers for n paths, allocated once per worker and reused."""
     return PathState(
-        key=np.zeros(n, np.uint64), pixel=np.zeros(n, np.int32),
+        key=np.zeros(n, np.uint64), pixel=np.zeros(n, np.int32), root=np.zeros(n, np.int32),
         ray_o=np.zeros((n, 3)), ray_d=np.zeros((n, 3)), ray_tmax=np.zeros(n),
         beta=np.zeros((n, 3)), radiance=np.zeros((n, 3)), transparency=np.zeros(n),
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),

@@ -29,15 +29,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import classic as C
 from . import features as features_mod
 from . import integrator as K
-from .bsdf import M_EMISSIVE, pack_materials
+from .bsdf import M_EMISSIVE, M_W_GLASS, M_W_MIRROR, M_W_REFRACT, pack_materials
 from .camera import pack_camera
 from .film import Film
 from .intersect import Accel
 from .lights import (L_PMF, light_distribution, pack_lights)
 from .sampling import filter_table
-from .scene import SceneDescription
+from .scene import SceneDescription, SceneError
 
 DEFAULT_BATCH = 1 << 17       # paths per chunk: ~50 MB of buffers per worker
 PASS_PATHS = 1 << 21          # a pass grows until it holds about this many paths
@@ -109,9 +110,13 @@ class _TimedAccel:
 class _Worker:
     """Buffers and counters of one worker thread, allocated once per render."""
 
-    def __init__(self, batch, accel):
+    def __init__(self, batch, accel, classic=False):
         self.state = K.alloc_path_state(batch)
         self.shadow = K.alloc_shadow_queue(batch)
+        if classic:   # a second generation of rays and per-camera-sample sums
+            self.next_state = K.alloc_path_state(batch)
+            self.acc = np.zeros((batch, 4))
+            self.root_pixel = np.zeros(batch, np.int32)
         self.stats = np.zeros(K.ST_SIZE, np.int64)
         self.embree_clock = [0.0]
         self.busy = 0.0
@@ -150,6 +155,9 @@ def build_scene_data(scene: SceneDescription):
 
     lamps, lamp_power = pack_lights(scene.lights, scene_radius)
     cdf, lamp_pmf, emit_pmf = light_distribution(lamp_power, emit_power)
+    emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
+    if emit_cdf[-1] > 0:
+        emit_cdf /= emit_cdf[-1]
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
     feats = features_mod.detect(scene, len(emit_tri), lamp_power)
@@ -161,7 +169,7 @@ def build_scene_data(scene: SceneDescription):
         verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
         mat_index=mat_index, materials=materials,
         lamps=lamps,
-        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, tri_light=tri_light,
+        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf, tri_light=tri_light,
         tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
         filter_table=filter_table(film.filter_type, film.filter_width))
 
@@ -200,10 +208,16 @@ class RenderSession:
         self.scene = scene.validate()
         self.threads = int(threads or default_threads())
         self.batch_size = int(batch_size or DEFAULT_BATCH)
-        self.stats = RenderStats(samples_target=scene.integrator.samples)
+        it = scene.integrator
+        self.stats = RenderStats(samples_target=it.samples)
         self.sc, self.cfg, self.fcfg, self.features = build_scene_data(scene)
+        self.method = it.method
+        self._classic_setup()
         x0, y0, x1, y1 = scene.film.window
         self.film = Film(x1 - x0, y1 - y0)
+        self.adaptive = Adaptive.from_settings(it)
+        self.active = np.arange(self.film.count.size, dtype=np.int32)
+        self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
         self.accel = Accel(scene.geometry.vertices, scene.geometry.triangles)
         self.stats.time_bvh = time.perf_counter() - t0
@@ -218,8 +232,8 @@ class RenderSession:
     # -- public ------------------------------------------------------------------------
     @property
     def samples_done(self) -> int:
-        """Samples every pixel has (the minimum over the film)."""
-        return self.film.samples_min()
+        """Samples of the pixels still being sampled (converged pixels stopped earlier)."""
+        return self.pass_samples if self.pass_samples else self.film.samples_min()
 
     def image(self) -> np.ndarray:
         """(h, w, 4) float32 linear RGBA of the film region, top row first."""
@@ -229,6 +243,10 @@ class RenderSession:
         """(h, w, 3) float32 variance of each pixel's mean (inf below 2 samples)."""
         return self.film.variance(self.scene.film.exposure)
 
+    def sample_counts(self) -> np.ndarray:
+        """(h, w) int: samples taken in each pixel (they differ with adaptive sampling)."""
+        return self.film.count.reshape(self.film.height, self.film.width).copy()
+
     def stop(self) -> None:
         """Ask a running ``run`` to stop after the chunks in flight."""
         self._stop.set()
@@ -237,23 +255,29 @@ class RenderSession:
         """Render the remaining samples; ``on_pass(self)`` after each pass."""
         target = self.scene.integrator.samples
         time_limit = self.scene.integrator.time_limit
-        npix = self.film.count.size
-        pixels = np.arange(npix, dtype=np.int32)
         t_start = time.perf_counter()
-        done = self.samples_done
+        spp = 1
         with ThreadPoolExecutor(max_workers=self.threads, thread_name_prefix="mcengine") as pool:
-            for spp in self._pass_schedule(done, target, npix):
+            while self.pass_samples < target and self.active.size:
                 if self._stopping(should_stop, t_start, time_limit):
                     break
-                ppc = self._pixels_per_chunk(spp, npix)
-                futures = {pool.submit(self._trace, pixels[a:a + ppc], spp)
-                           for a in range(0, npix, ppc)}
+                k = self._pass_size(spp, target)
+                ppc = self._pixels_per_chunk(k, self.active.size)
+                pixels = self.active
+                futures = {pool.submit(self._trace, pixels[a:a + ppc], k)
+                           for a in range(0, pixels.size, ppc)}
                 while futures:
                     finished, futures = wait(futures, timeout=0.1, return_when=FIRST_COMPLETED)
                     for f in finished:
                         f.result()   # re-raise worker errors here
                     if futures and self._stopping(should_stop, t_start, time_limit):
                         self._stop.set()
+                if not self._stop.is_set():
+                    self.pass_samples += k
+                    if self.adaptive is not None:
+                        self.active = self.adaptive.unconverged(self.film, self.pass_samples)
+                if self.pass_samples > 1:
+                    spp *= 2
                 self._update_stats(t_start)
                 if on_pass is not None:
                     on_pass(self)
@@ -263,6 +287,30 @@ class RenderSession:
         return self
 
     # -- internals -----------------------------------------------------------------------
+    def _classic_setup(self):
+        it = self.scene.integrator
+        if self.method == "path":
+            self.roots_per_chunk = self.batch_size
+            return
+        self.mode = {"raycast": C.MODE_RAYCAST, "whitted": C.MODE_WHITTED,
+                     "distribution": C.MODE_DISTRIBUTION}[self.method]
+        self.depth = 1 if self.method == "raycast" else int(it.depth)
+        self.branching = int(it.branching)
+        m = self.sc.materials
+        # Whitted spawns one ray per specular lobe and two for glass.
+        whitted_children = int(((m[:, M_W_MIRROR] > 0) + 2 * (m[:, M_W_GLASS] > 0)
+                                + (m[:, M_W_REFRACT] > 0)).max(initial=1))
+        b = self.branching if self.method == "distribution" else max(whitted_children, 1)
+        widest = b ** (self.depth - 1)
+        if widest > self.batch_size:
+            raise SceneError(
+                f"{self.method}: {b}^{self.depth - 1} = {widest} rays in the last ray level "
+                f"per camera sample exceed the batch of {self.batch_size}; lower the depth"
+                + (" or the branching" if self.method == "distribution" else ""))
+        self.roots_per_chunk = max(1, self.batch_size // widest)
+        total = float(self.sc.emit_pmf.sum())
+        self.emit_scale = 1.0 / total if total > 0 else 0.0
+
     def _stopping(self, should_stop, t_start, time_limit) -> bool:
         if self._stop.is_set():
             return True
@@ -270,50 +318,53 @@ class RenderSession:
             return True
         return bool(should_stop is not None and should_stop())
 
-    @staticmethod
-    def _pass_schedule(done, target, npix):
-        """Samples per pixel of each pass: 1, 1, 2, 4, ... capped at ~PASS_PATHS per pass."""
-        cap = max(1, PASS_PATHS // max(npix, 1))
-        spp = 1
-        first = True
-        while done < target:
-            k = min(spp, cap, target - done)
-            yield k
-            done += k
-            if not first:
-                spp *= 2
-            first = False
+    def _pass_size(self, spp, target):
+        """Samples per pixel of the next pass: 1, 1, 2, 4, ... capped at ~PASS_PATHS paths."""
+        cap = max(1, PASS_PATHS // max(self.active.size, 1))
+        cap = min(cap, max(1, self.roots_per_chunk))
+        if self.adaptive is not None:
+            # Stop at the minimum and at every check point, so convergence is
+            # tested there.
+            cap = min(cap, self.adaptive.next_check(self.pass_samples) - self.pass_samples)
+        return max(1, min(spp, cap, target - self.pass_samples))
 
     def _pixels_per_chunk(self, spp, npix):
         paths = spp * npix
-        # At least two chunks per worker for load balance, at most batch_size paths each.
-        per_chunk = min(self.batch_size, max(MIN_CHUNK_PATHS, -(-paths // (2 * self.threads))))
+        # At least two chunks per worker for load balance, at most a batch each.
+        per_chunk = min(self.roots_per_chunk, max(MIN_CHUNK_PATHS, -(-paths // (2 * self.threads))))
         return max(1, min(npix, per_chunk // spp))
 
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(self.batch_size, self.accel)
+            w = _Worker(self.batch_size, self.accel, classic=self.method != "path")
             self._workers.w = w
             with self._lock:
                 self._all_workers.append(w)
         return w
+
+    def _trace_with(self, w, pixels, spp, film):
+        if self.method == "path":
+            K.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, w.state, w.shadow,
+                          film, w.stats)
+        else:
+            C.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
+                                  (w.state, w.next_state, w.shadow, w.acc, w.root_pixel), film,
+                                  w.stats, self.mode, self.depth, self.branching, self.emit_scale)
 
     def _trace(self, pixels, spp):
         if self._stop.is_set():
             return
         w = self._worker()
         t0 = time.perf_counter()
-        K.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, w.state, w.shadow,
-                      self.film.arrays, w.stats)
+        self._trace_with(w, pixels, spp, self.film.arrays)
         w.busy += time.perf_counter() - t0
 
     def _warm_up(self):
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
-        w = _Worker(64, self.accel)
-        scratch = Film(1, 1)
-        K.trace_chunk(np.zeros(1, np.int32), 1, w.accel, self.sc, self.cfg, self.fcfg,
-                      w.state, w.shadow, scratch.arrays, w.stats)
+        w = _Worker(max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self.method != "path"
+                    else 64, self.accel, classic=self.method != "path")
+        self._trace_with(w, np.zeros(1, np.int32), 1, Film(1, 1).arrays)
 
     def _update_stats(self, t_start):
         s = self.stats
@@ -332,5 +383,79 @@ class RenderSession:
         s.time_embree = sum(w.embree_clock[0] for w in workers)
         s.time_workers = sum(w.busy for w in workers)
         s.samples_done = self.samples_done
-        remaining = (s.samples_target - s.samples_done) * self.film.count.size
+        if self.adaptive is not None:
+            remaining = self.adaptive.remaining_samples(self.film, self.active,
+                                                        self.scene.integrator.samples)
+        else:
+            remaining = (s.samples_target - s.samples_done) * self.film.count.size
         s.eta_seconds = remaining / s.paths_per_second if s.paths_per_second > 0 else float("nan")
+
+
+class Adaptive:
+    """Adaptive sampling: pixels stop once their estimated noise is below a threshold.
+
+    A pixel's error is the standard error of its mean, summed over RGB in
+    quadrature, relative to its brightness the way Cycles normalises it
+    (kernel/film/adaptive_sampling.h): divided by sqrt(sum RGB) below 1,
+    where the eye is more sensitive to noise, and by sum RGB above 1.  Every
+    pixel takes at least ``min_samples``; convergence is checked every
+    ``CHECK_EVERY`` samples after that, and the unconverged pixels' 3x3
+    neighbours keep sampling too, as in Cycles, so a feature that the noise
+    estimate missed in one pixel is not left half-sampled.
+    """
+
+    CHECK_EVERY = 16
+
+    def __init__(self, threshold, min_samples):
+        self.threshold = float(threshold)
+        self.min_samples = int(min_samples)
+
+    @staticmethod
+    def from_settings(it):
+        if not it.use_adaptive_sampling:
+            return None
+        threshold = it.adaptive_threshold if it.adaptive_threshold > 0 else max(0.001, 1.0 / it.samples)
+        min_samples = it.adaptive_min_samples
+        if min_samples <= 0:    # Cycles' automatic minimum
+            min_samples = max(4, int(math.ceil(16.0 / threshold ** 0.3)))
+        return Adaptive(threshold, min(min_samples, it.samples))
+
+    def next_check(self, done):
+        if done < self.min_samples:
+            return self.min_samples
+        return done + self.CHECK_EVERY
+
+    def error(self, film):
+        """(n,) relative error of every film pixel (inf below 2 samples)."""
+        n = film.count.astype(np.float64)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            mean = film.sum[:, :3] / n[:, None]
+            var = (film.sum_sq - n[:, None] * mean * mean) / (n[:, None] - 1.0) / n[:, None]
+            se = np.sqrt(np.maximum(var, 0.0).sum(axis=1))
+            total = mean.sum(axis=1)
+            scale = np.where(total < 1.0, np.sqrt(np.maximum(total, 0.0)), total)
+            err = se / (1e-4 + scale)
+        return np.where(n >= 2, err, np.inf)
+
+    def unconverged(self, film, done):
+        """Indices of the pixels that keep sampling after ``done`` samples."""
+        if done < self.min_samples:
+            return np.arange(film.count.size, dtype=np.int32)
+        open_ = (self.error(film) >= self.threshold).reshape(film.height, film.width)
+        grown = open_.copy()   # 3x3 dilation
+        grown[1:, :] |= open_[:-1, :]
+        grown[:-1, :] |= open_[1:, :]
+        g2 = grown.copy()
+        g2[:, 1:] |= grown[:, :-1]
+        g2[:, :-1] |= grown[:, 1:]
+        return np.flatnonzero(g2.ravel()).astype(np.int32)
+
+    def remaining_samples(self, film, active, max_samples):
+        """Estimated samples still to take: error falls as 1/sqrt(n)."""
+        if active.size == 0:
+            return 0
+        n = film.count[active].astype(np.float64)
+        err = self.error(film)[active]
+        needed = np.where(np.isfinite(err), n * (err / self.threshold) ** 2, max_samples)
+        needed = np.clip(np.maximum(needed, self.min_samples), 0, max_samples)
+        return float(np.maximum(needed - n, 0).sum())

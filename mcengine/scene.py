@@ -219,8 +219,18 @@ class Film:
 
 @dataclass
 class Integrator:
-    """Sampling and path settings, named as Cycles names them."""
+    """Sampling and path settings, named as Cycles names them.
 
+    ``method`` chooses the algorithm (see :mod:`mcengine.classic`): "path"
+    (path tracing, the default and the only one that matches Cycles),
+    "raycast", "whitted" (mirror and refraction rays down to ``depth`` ray
+    levels) or "distribution" (``branching`` rays at every hit, ``depth``
+    levels).
+    """
+
+    method: str = "path"
+    depth: int = 5
+    branching: int = 4
     samples: int = 64
     seed: int = 0
     max_bounces: int = 12
@@ -232,6 +242,9 @@ class Integrator:
     clamp_direct: float = 0.0        # 0 = off
     clamp_indirect: float = 0.0      # 0 = off
     time_limit: float = 0.0          # seconds, 0 = none
+    use_adaptive_sampling: bool = False
+    adaptive_threshold: float = 0.01   # relative noise at which a pixel stops (0: automatic)
+    adaptive_min_samples: int = 0      # samples before a pixel may stop (0: automatic)
 
 
 @dataclass
@@ -299,6 +312,11 @@ class SceneDescription:
         if c.type == "PERSP" and c.lens <= 0:
             raise SceneError("camera focal length must be positive")
         i = self.integrator
+        if i.method not in ("path", "raycast", "whitted", "distribution"):
+            raise SceneError(f"unknown integrator {i.method!r} (path, raycast, whitted, distribution)")
+        if i.depth < 1 or i.branching < 1:
+            raise SceneError(f"integrator depth and branching must be at least 1, got "
+                             f"{i.depth} and {i.branching}")
         if i.samples < 1:
             raise SceneError(f"samples must be at least 1, got {i.samples}")
         for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):

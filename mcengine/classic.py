@@ -1,0 +1,352 @@
+"""The lecture's classic algorithms: ray casting, Whitted and distribution ray tracing.
+
+They differ from path tracing in how rays branch at a surface hit:
+
+* ``raycast``: the camera ray only; direct light from every light, no
+  recursion.  Light reflected from other surfaces, the world's light on
+  surfaces and everything seen in mirrors or through glass is missing: a
+  biased, fast image;
+* ``whitted``: direct light from every light, plus perfect mirror reflection
+  and refraction rays (both at a glass surface, weighted by Fresnel) down to
+  ``depth`` ray levels.  Diffuse surfaces do not spawn rays, so where every
+  hit is glass the ray tree is binary: 2^depth - 1 rays per camera sample;
+* ``distribution``: direct light from every light, plus ``branching`` (b)
+  BSDF-sampled secondary rays at every hit, each carrying 1/b of the weight,
+  down to ``depth`` ray levels: 1 + b + ... + b^(depth-1) rays per camera
+  sample, the lecture's p * n * b^r.  Light found by secondary rays is
+  combined with the light samples by multiple importance sampling; at the
+  last level, where no rays follow, the light samples take full weight.
+  Its expected value equals path tracing with depth - 1 bounces.
+
+"Every light" means one sample on each lamp and one on the emissive
+triangles as a group (picked by power).  The depth counts ray levels, the
+camera ray being level 1, as in the lecture.
+
+Wavefront execution: each generation of rays is one Embree call; the
+shading kernel writes the next generation into a second buffer.  A chunk
+holds few enough camera samples that its widest generation fits the batch.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .bsdf import (LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT, M_EMISSION, M_EMISSIVE, M_GLASS,
+                   M_IOR, M_MIRROR, M_REFRACT, M_W_GLASS, M_W_MIRROR, M_W_REFRACT, bsdf_eval,
+                   bsdf_has_lobes, bsdf_sample, fresnel_dielectric)
+from .integrator import (CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD, CFG_WORLD_CAMERA,
+                         CFG_LAMPS_HIT, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
+                         PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SHADOW_RAYS,
+                         clamp_light, emission_weight, generate_camera_rays, hit_distance,
+                         lamps_on_segment, local_frame, next_path_flags, power_heuristic,
+                         push_shadow, sample_light, set_ray, skip_self_hit, sun_light,
+                         surface_geometry)
+from .intersect import offset_origin
+from .jit import device, kernel
+from .lights import L_PMF, pick_light
+from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_LIGHT_PICK, DIM_LIGHT_U,
+                       DIM_LIGHT_V, mix64, rand)
+
+METHODS = ("path", "raycast", "whitted", "distribution")
+MODE_RAYCAST = 1
+MODE_WHITTED = 2
+MODE_DISTRIBUTION = 3
+_K_CHILD = np.uint64(0xA24BAED4963EE407)
+_K_LIGHT = np.uint64(0x9FB21C651E98DF25)
+
+
+def rays_per_sample_bound(method: str, depth: int, branching: int) -> int:
+    """Most closest-hit rays one camera sample can cast (the lecture's formulas)."""
+    if method == "raycast":
+        return 1
+    b = 2 if method == "whitted" else branching
+    return sum(b ** k for k in range(depth))
+
+
+def widest_generation(method: str, depth: int, branching: int) -> int:
+    """Most rays of one generation per camera sample."""
+    if method == "raycast":
+        return 1
+    b = 2 if method == "whitted" else branching
+    return b ** (depth - 1)
+
+
+@device
+def _accumulate(acc, root, r, g, b, direct, fcfg, stats):
+    limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
+    r, g, b = clamp_light(r, g, b, limit, stats)
+    acc[root, 0] += r
+    acc[root, 1] += g
+    acc[root, 2] += b
+
+
+@device
+def _push_child(nx, n_next, st, i, key, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
+                br, bg, bb, flags, mis_pdf, p):
+    """Write the next-generation node ``n_next`` from node i; returns n_next + 1."""
+    nx.key[n_next] = key
+    nx.pixel[n_next] = st.pixel[i]
+    nx.root[n_next] = st.root[i]
+    nx.beta[n_next, 0], nx.beta[n_next, 1], nx.beta[n_next, 2] = br, bg, bb
+    nx.bounce[n_next] = st.bounce[i] + 1
+    nx.transparent[n_next] = st.transparent[i]
+    nx.flags[n_next] = flags
+    nx.mis_pdf[n_next] = mis_pdf
+    nx.self_prim[n_next] = p
+    ox, oy, oz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
+    set_ray(nx, n_next, ox, oy, oz, wix, wiy, wiz, math.inf)
+    return n_next + 1
+
+
+@device
+def _copy_node(nx, n_next, st, i):
+    """Carry node i unchanged into the next generation (a re-traced ray)."""
+    nx.key[n_next] = st.key[i]
+    nx.pixel[n_next] = st.pixel[i]
+    nx.root[n_next] = st.root[i]
+    for c in range(3):
+        nx.beta[n_next, c] = st.beta[i, c]
+    nx.bounce[n_next] = st.bounce[i]
+    nx.transparent[n_next] = st.transparent[i]
+    nx.flags[n_next] = st.flags[i]
+    nx.mis_pdf[n_next] = st.mis_pdf[i]
+    nx.self_prim[n_next] = st.self_prim[i]
+    set_ray(nx, n_next, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2],
+            st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2], st.ray_tmax[i])
+    return n_next + 1
+
+
+@kernel
+def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stats,
+                  mode, depth, branching, emit_scale):
+    """Shade nodes [start, end); children go to ``nx`` from ``n_next`` on.
+
+    Returns ``(n_shadow, n_next)``.  Light is added to the per-camera-sample
+    accumulators ``acc[root]`` (RGB and transparency); shadow rays name the
+    root they belong to.
+    """
+    n_shadow = 0
+    n_lamps = sc.lamps.shape[0]
+    lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    for i in range(start, end):
+        p = prim[i]
+        if skip_self_hit(st, i, sc, p, stats):
+            n_next = _copy_node(nx, n_next, st, i)
+            continue
+        root = st.root[i]
+        flags = st.flags[i]
+        bounce = st.bounce[i]
+        br, bg, bb = st.beta[i, 0], st.beta[i, 1], st.beta[i, 2]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        t_hit, b1, b2 = hit_distance(st, i, sc, p)
+        arrival_direct = bounce <= 1
+
+        if lamps_hit:
+            lr, lg, lb, passed = lamps_on_segment(
+                sc, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2], dx, dy, dz, t_hit, flags,
+                st.mis_pdf[i], True, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+            if passed:
+                _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
+                if st.transparent[i] + passed >= cfg[CFG_MAX_TRANSPARENT]:
+                    continue
+        if p < 0:
+            if flags & PF_TRANSPARENT_BG:
+                acc[root, 3] = 1.0
+            elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
+                _accumulate(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
+                            arrival_direct, fcfg, stats)
+            if n_lamps:
+                lr, lg, lb = sun_light(sc, dx, dy, dz, flags, st.mis_pdf[i], True)
+                if lr + lg + lb > 0.0:
+                    _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
+            continue
+        if sc.tri_area[p] <= 0.0:
+            continue
+        hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing = surface_geometry(
+            sc, p, b1, b2, dx, dy, dz)
+        m = sc.mat_index[p]
+        if sc.materials[m, M_EMISSIVE] > 0.0:
+            w = emission_weight(sc, p, t_hit, cos_o_geo, flags, st.mis_pdf[i], emit_scale)
+            _accumulate(acc, root, br * sc.materials[m, M_EMISSION] * w,
+                        bg * sc.materials[m, M_EMISSION + 1] * w,
+                        bb * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
+        if not bsdf_has_lobes(sc.materials, m):
+            continue
+        key = st.key[i]
+        tx, ty, tz, bx, by, bz, wox, woy, woz = local_frame(nsx, nsy, nsz, dx, dy, dz)
+        spawn = bounce + 2 <= depth          # the children's level is bounce + 2
+        # Light samples share MIS with the BSDF rays only if BSDF rays follow.
+        nee_mis = mode == MODE_DISTRIBUTION and spawn
+
+        # -- direct light from every light ------------------------------------------
+        if cfg[CFG_LIGHTS]:
+            n_emit = sc.emit_tri.shape[0]
+            for li in range(n_lamps + (1 if n_emit else 0)):
+                if li < n_lamps:
+                    if sc.lamps[li, L_PMF] <= 0.0:
+                        continue
+                    idx = li
+                    pmf = 1.0
+                else:
+                    j = pick_light(sc.emit_cdf, rand(key, DIM_LIGHT_PICK))
+                    idx = n_lamps + j
+                    pmf = sc.emit_pmf[j] * emit_scale
+                lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
+                (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
+                 lnx, lny, lnz) = sample_light(sc, idx, pmf, hx, hy, hz, bounce,
+                                               rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V))
+                if lr + lg + lb <= 0.0 or wix * ngx + wiy * ngy + wiz * ngz <= 0.0:
+                    continue
+                fr, fg, fb, bsdf_pdf = bsdf_eval(
+                    sc.materials, m, wox, woy, woz, wix * tx + wiy * ty + wiz * tz,
+                    wix * bx + wiy * by + wiz * bz, wix * nsx + wiy * nsy + wiz * nsz, exclude)
+                w = power_heuristic(pdf_l, branching * bsdf_pdf) if (nee_mis and use_mis) else 1.0
+                cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
+                if cr + cg + cb <= 0.0:
+                    continue
+                limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
+                cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
+                if cast_shadow:
+                    n_shadow = push_shadow(sq, n_shadow, root, hx, hy, hz, ngx, ngy, ngz,
+                                           wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb)
+                else:
+                    acc[root, 0] += cr
+                    acc[root, 1] += cg
+                    acc[root, 2] += cb
+        if not spawn:
+            continue
+
+        # -- secondary rays -------------------------------------------------------------
+        if mode == MODE_DISTRIBUTION:
+            for c in range(branching):
+                ckey = mix64(key ^ (np.uint64(c + 1) * _K_CHILD))
+                wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
+                    sc.materials, m, wox, woy, woz, backfacing, rand(ckey, DIM_BSDF_LOBE),
+                    rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V))
+                if (pdf <= 0.0 and not (label & LABEL_SINGULAR)) or wr + wg + wb <= 0.0:
+                    continue
+                wix = wlx * tx + wly * bx + wlz * nsx
+                wiy = wlx * ty + wly * by + wlz * nsy
+                wiz = wlx * tz + wly * bz + wlz * nsz
+                cos_i_geo = wix * ngx + wiy * ngy + wiz * ngz
+                if (label & LABEL_REFLECT and cos_i_geo <= 0.0) or \
+                        (label & LABEL_TRANSMIT and cos_i_geo >= 0.0):
+                    continue
+                k = 1.0 / branching
+                n_next = _push_child(nx, n_next, st, i, ckey, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
+                                     br * wr * k, bg * wg * k, bb * wb * k,
+                                     next_path_flags(flags, label), branching * pdf, p)
+        else:
+            # Whitted: every perfect-specular lobe spawns its ray, weighted
+            # deterministically (Fresnel splits glass into both).
+            eta = sc.materials[m, M_IOR]
+            if backfacing:
+                eta = 1.0 / eta
+            f, cos_t = fresnel_dielectric(woz, eta)
+            for lobe in range(4):
+                if lobe == 0:
+                    if sc.materials[m, M_W_MIRROR] <= 0.0:
+                        continue
+                    col, scale, refract = M_MIRROR, 1.0, False
+                elif lobe == 1 or lobe == 2:
+                    if sc.materials[m, M_W_GLASS] <= 0.0:
+                        continue
+                    refract = lobe == 2
+                    col, scale = M_GLASS, (1.0 - f) if refract else f
+                else:
+                    if sc.materials[m, M_W_REFRACT] <= 0.0:
+                        continue
+                    col, scale, refract = M_REFRACT, 1.0 - (1.0 if cos_t <= 0.0 else 0.0), True
+                if scale <= 0.0:
+                    continue
+                if refract:
+                    wlx, wly, wlz = -wox / eta, -woy / eta, -cos_t
+                    label = LABEL_TRANSMIT | LABEL_SINGULAR
+                else:
+                    wlx, wly, wlz = -wox, -woy, woz
+                    label = LABEL_REFLECT | LABEL_SINGULAR
+                wix = wlx * tx + wly * bx + wlz * nsx
+                wiy = wlx * ty + wly * by + wlz * nsy
+                wiz = wlx * tz + wly * bz + wlz * nsz
+                cos_i_geo = wix * ngx + wiy * ngy + wiz * ngz
+                if (refract and cos_i_geo >= 0.0) or (not refract and cos_i_geo <= 0.0):
+                    continue
+                ckey = mix64(key ^ (np.uint64(lobe + 1) * _K_CHILD))
+                n_next = _push_child(nx, n_next, st, i, ckey, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
+                                     br * sc.materials[m, col] * scale,
+                                     bg * sc.materials[m, col + 1] * scale,
+                                     bb * sc.materials[m, col + 2] * scale,
+                                     next_path_flags(flags, label), 0.0, p)
+    return n_shadow, n_next
+
+
+@kernel
+def add_unoccluded(n_shadow, occluded, sq, acc):
+    for s in range(n_shadow):
+        if not occluded[s]:
+            r = sq.path[s]
+            acc[r, 0] += sq.contrib[s, 0]
+            acc[r, 1] += sq.contrib[s, 1]
+            acc[r, 2] += sq.contrib[s, 2]
+
+
+@kernel
+def splat_roots(n, root_pixel, acc, film_sum, film_sq, film_n):
+    for r in range(n):
+        pix = root_pixel[r]
+        cr, cg, cb = acc[r, 0], acc[r, 1], acc[r, 2]
+        film_sum[pix, 0] += cr
+        film_sum[pix, 1] += cg
+        film_sum[pix, 2] += cb
+        film_sum[pix, 3] += 1.0 - acc[r, 3]
+        film_sq[pix, 0] += cr * cr
+        film_sq[pix, 1] += cg * cg
+        film_sq[pix, 2] += cb * cb
+        film_n[pix] += 1
+
+
+@kernel
+def _start_roots(n, st, root_pixel, acc):
+    for i in range(n):
+        st.root[i] = i
+        root_pixel[i] = st.pixel[i]
+        acc[i, 0] = acc[i, 1] = acc[i, 2] = acc[i, 3] = 0.0
+
+
+def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
+                        mode, depth, branching, emit_scale):
+    """Trace spp camera samples for each pixel with a classic integrator.
+
+    ``buffers`` = (state A, state B, shadow queue, acc (B, 4), root_pixel (B,)).
+    The caller sizes the chunk so that its widest generation fits the states
+    and at most ``shadow capacity / lights per hit`` nodes are shaded at once.
+    """
+    cur, nxt, sq, acc, root_pixel = buffers
+    film_sum, film_sq, film_n = film
+    n = generate_camera_rays(pixels, spp, film_n, cur, sc, cfg)
+    n_roots = n
+    _start_roots(n, cur, root_pixel, acc)
+    stats[ST_CAMERA_RAYS] += n
+    lights_per_hit = sc.lamps.shape[0] + 1
+    slice_nodes = max(1, sq.path.shape[0] // lights_per_hit)
+    first = True
+    for _ in range(4 * (depth + int(cfg[CFG_MAX_TRANSPARENT])) + 8):
+        if n == 0:
+            break
+        if not first:
+            stats[ST_BOUNCE_RAYS] += n
+        first = False
+        prim = accel.closest(cur.o32[:n], cur.d32[:n], cur.t32[:n])
+        n_next = 0
+        for start in range(0, n, slice_nodes):
+            end = min(n, start + slice_nodes)
+            n_shadow, n_next = shade_classic(start, end, prim, cur, nxt, n_next, sq, acc, sc, cfg,
+                                             fcfg, stats, mode, depth, branching, emit_scale)
+            if n_shadow:
+                occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
+                stats[ST_SHADOW_RAYS] += n_shadow
+                add_unoccluded(n_shadow, occluded, sq, acc)
+        cur, nxt = nxt, cur
+        n = n_next
+    splat_roots(n_roots, root_pixel, acc, film_sum, film_sq, film_n)

@@ -9,8 +9,30 @@ import bpy
 __all__ = ["MCEngineSceneSettings", "register", "unregister"]
 
 
+INTEGRATORS = [
+    ("PATH", "Path Tracing", "One secondary ray per bounce, light sampling with multiple "
+     "importance sampling, Russian roulette; matches Cycles", 0),
+    ("RAYCAST", "Ray Casting", "Camera rays and direct light from every light; no reflected "
+     "light: fast and biased", 1),
+    ("WHITTED", "Whitted", "Direct light plus perfect mirror and refraction rays down to Depth "
+     "ray levels: 2^depth - 1 rays per sample at most", 2),
+    ("DISTRIBUTION", "Distribution", "Direct light plus Branching rays at every hit down to Depth "
+     "ray levels: 1 + b + ... + b^(depth-1) rays per sample", 3),
+]
+
+
 class MCEngineSceneSettings(bpy.types.PropertyGroup):
-    """Per-scene MC Engine data (integrator options will go here)."""
+    """Per-scene MC Engine settings that Cycles has no equivalent for."""
+
+    integrator: bpy.props.EnumProperty(
+        name="Integrator", items=INTEGRATORS, default="PATH",
+        description="Light transport algorithm")
+    depth: bpy.props.IntProperty(
+        name="Depth", default=5, min=1, max=16,
+        description="Ray levels of Whitted and distribution ray tracing (the camera ray is level 1)")
+    branching: bpy.props.IntProperty(
+        name="Branching", default=4, min=1, max=64,
+        description="Secondary rays per hit in distribution ray tracing")
 
     last_effects: bpy.props.StringProperty(
         name="Effects",

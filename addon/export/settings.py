@@ -75,9 +75,6 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
     if cycles.use_denoising:
         ctx.warn("Cycles denoising is enabled for this scene: not supported yet; "
                  "rendering all samples without denoising", "denoising")
-    if cycles.use_adaptive_sampling:
-        ctx.warn(f"Cycles adaptive sampling is enabled for this scene: not supported yet; "
-                 f"rendering all {samples} samples in every pixel", "adaptive sampling")
     if scene.render.use_motion_blur:
         ctx.warn("motion blur is enabled: not supported yet; rendering the frame without it",
                  "motion blur")
@@ -93,4 +90,17 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
         clamp_direct=float(cycles.sample_clamp_direct),
         clamp_indirect=float(cycles.sample_clamp_indirect),
         time_limit=float(cycles.time_limit),
+        use_adaptive_sampling=bool(cycles.use_adaptive_sampling),
+        adaptive_threshold=float(cycles.adaptive_threshold),
+        adaptive_min_samples=int(cycles.adaptive_min_samples),
+        **mcengine_settings(scene),
     )
+
+
+def mcengine_settings(scene) -> dict:
+    """MC Engine's own integrator choice (``scene.mcengine``), for the Integrator."""
+    own = getattr(scene, "mcengine", None)
+    if own is None:
+        return {}
+    return {"method": own.integrator.lower(), "depth": int(own.depth),
+            "branching": int(own.branching)}

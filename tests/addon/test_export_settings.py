@@ -21,6 +21,15 @@ def test_integrator_reads_cycles_settings(scene, fake_session):
     assert desc.warnings == []
 
 
+def test_adaptive_sampling_and_integrator_choice(scene, fake_session):
+    c = scene.cycles
+    c.use_adaptive_sampling, c.adaptive_threshold, c.adaptive_min_samples = True, 0.03, 12
+    scene.mcengine.integrator, scene.mcengine.depth, scene.mcengine.branching = "DISTRIBUTION", 3, 6
+    i = export_scene(fake_session).integrator
+    assert (i.use_adaptive_sampling, i.adaptive_threshold, i.adaptive_min_samples) == (True, pytest.approx(0.03), 12)
+    assert (i.method, i.depth, i.branching) == ("distribution", 3, 6)
+
+
 def test_view_layer_samples_override(scene, fake_session):
     scene.cycles.samples = 64
     bpy.context.view_layer.samples = 5
@@ -74,11 +83,8 @@ def test_unsupported_sampling_features_are_warned(scene, fake_session):
     warnings = export_scene(fake_session).warnings
     assert warnings == [
         DENOISE,
-        "Cycles adaptive sampling is enabled for this scene: not supported yet; rendering all 16 "
-        "samples in every pixel",
         "motion blur is enabled: not supported yet; rendering the frame without it",
     ]
-    assert scene.mcengine.last_ignored == "denoising, adaptive sampling, motion blur"
 
 
 def test_without_cycles_the_defaults_are_used_with_one_warning(scene, fake_session, addon):

@@ -85,9 +85,9 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
     assert panel_lines == ["Not rendered yet"]
     bpy.ops.render.render()
     assert scene.mcengine.last_effects == "Diffuse, Emission, 1 Sun"
-    assert scene.mcengine.last_ignored == "specular, denoising, adaptive sampling"
+    assert scene.mcengine.last_ignored == "specular, denoising"
     assert _panel_text(addon, scene) == ["Effects: Diffuse, Emission, 1 Sun",
-                                         "Ignored: specular, denoising, adaptive sampling"]
+                                         "Ignored: specular, denoising"]
 
 
 def _panel_text(addon, scene):

@@ -1,0 +1,151 @@
+"""mcengine.report: the comparison report, its figure and the suite table (no bpy).
+
+Synthetic stacks with known noise and known differences stand in for renders.
+"""
+import json
+import math
+import struct
+
+import numpy as np
+import pytest
+
+from mcengine.compare import compare_stacks
+from mcengine.report import (EngineRuns, SuiteRow, build_comparison, detectable_bias,
+                             differing_regions, suite_html, suite_markdown, suite_row,
+                             write_comparison, write_suite)
+
+H, W = 48, 64
+NOISE = 0.05  # relative per-pixel noise of one render
+
+
+def _image():
+    """A smooth, coloured (h, w, 3) image between 0.2 and 0.8."""
+    y, x = np.mgrid[0:H, 0:W] / np.array([H, W])[:, None, None]
+    return np.stack([0.2 + 0.5 * x, 0.3 + 0.4 * y, np.full_like(x, 0.4)], axis=-1)
+
+
+def _runs(image, rng, k=2, seconds=1.0):
+    stack = image * (1.0 + NOISE * rng.standard_normal((k,) + image.shape))
+    return EngineRuns(images=stack.astype(np.float32), seconds=[seconds] * k, samples=16,
+                      seeds=list(range(1, k + 1)))
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(7)
+
+
+def test_a_brighter_rectangle_is_one_region_with_its_pixels(rng):
+    ours = _image()
+    ours[12:24, 16:40] *= 1.2       # exactly blocks rows 2-3, columns 2-4 of the 8x8 grid
+    c = build_comparison("rect", _runs(ours, rng), _runs(_image(), rng))
+    assert c.verdict == "differ"
+    (region,) = c.report["regions"]
+    assert region["pixels"] == [16, 12, 40, 24]
+    assert region["blocks"] == 6 and region["ours"] == "brighter"
+    assert region["where"] == "middle centre"
+    assert set(region["channels"]) == {"R", "G", "B"}
+    for rel in region["channels"].values():
+        assert rel == pytest.approx(0.2, abs=0.03)
+
+
+def test_two_separate_patches_are_two_regions(rng):
+    ours = _image()
+    ours[0:6, 0:8, 0] *= 1.4        # block (0, 0), red only, brighter
+    ours[42:48, 56:64] *= 0.7       # block (7, 7), darker
+    c = build_comparison("two", _runs(ours, rng), _runs(_image(), rng))
+    regions = sorted(differing_regions(c.agreement), key=lambda r: r["pixels"])
+    assert [r["pixels"] for r in regions] == [[0, 0, 8, 6], [56, 42, 64, 48]]
+    assert list(regions[0]["channels"]) == ["R"] and regions[0]["ours"] == "brighter"
+    assert regions[1]["ours"] == "darker" and regions[1]["where"] == "bottom right"
+
+
+def test_equal_images_agree_and_report_is_strict_json(rng, tmp_path):
+    c = build_comparison("same", _runs(_image(), rng, seconds=2.0), _runs(_image(), rng))
+    assert c.verdict == "agree"
+    paths = write_comparison(c, tmp_path)
+    report = json.loads(paths["report.json"].read_text(), parse_constant=pytest.fail)
+    assert report["verdict"] == "agree" and list(report)[0] == "verdict"
+    assert report["regions"] == [] and report["blocks"]["differ"] == 0
+    assert report["times"]["mcengine"]["mean"] == 2.0
+    for ch in "RGB":
+        mean = report["means"]["mcengine"][ch]
+        lo, hi = mean["ci"]
+        assert lo < mean["mean"] < hi
+        assert hi - lo == pytest.approx(2 * 1.959964 * mean["se"], rel=1e-5)
+    assert 0 < report["metrics"]["flip"] < 0.2 and report["metrics"]["relmse"] > 0
+    markdown = paths["report.md"].read_text()
+    assert "**Verdict: AGREE**" in markdown and "No block differs significantly." in markdown
+
+
+def test_side_by_side_has_four_scaled_panels(rng, tmp_path):
+    c = build_comparison("fig", _runs(_image(), rng), _runs(_image(), rng))
+    paths = write_comparison(c, tmp_path)
+    data = paths["side_by_side.png"].read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = struct.unpack(">II", data[16:24])
+    assert width >= 4 * 320 and height >= 320 * H / W
+    thumb = paths["thumbnail.png"].read_bytes()
+    assert struct.unpack(">II", thumb[16:24])[1] == 96
+
+
+def test_detectable_bias_is_found_with_95_percent_probability():
+    """Simulate: the stated detectable bias is found >= ~95 %, half of it rarely.
+
+    (So the number is neither optimistic nor uselessly conservative.)
+    """
+    rng = np.random.default_rng(11)
+    image = _image()[:16, :16]
+    probe = build_comparison("probe", _runs(image, rng), _runs(image, rng))
+    bias = float(detectable_bias(probe.agreement).min())
+    assert 0 < bias < 0.1
+    trials = 60
+
+    def found(rel):
+        hits = 0
+        for _ in range(trials):
+            a = compare_stacks(_runs(image * (1 + rel), rng).images, _runs(image, rng).images)
+            hits += a.frame_rejected.any()
+        return hits / trials
+
+    # 95 % per channel; with three channels at least one is found more often.
+    assert found(bias) >= 0.9
+    assert found(0.5 * bias) < 0.5
+
+
+def test_detectable_bias_follows_the_noise(rng):
+    quiet = build_comparison("q", _runs(_image(), rng, k=8), _runs(_image(), rng, k=8))
+    noisy = build_comparison("n", _runs(_image(), rng, k=2), _runs(_image(), rng, k=2))
+    ratio = detectable_bias(noisy.agreement) / detectable_bias(quiet.agreement)
+    assert np.all((ratio > 1.5) & (ratio < 2.5)), ratio      # sqrt(8 / 2) = 2
+
+
+def _row(name, verdict="agree", **kw):
+    base = dict(scene=name, verdict=verdict, folder=name, relmse=0.001, flip=0.02,
+                seconds_ours=2.0, seconds_cycles=1.0, max_abs_bias=0.001,
+                detectable_bias=0.01, blocks_differ="0/64", resolution="64x64",
+                samples="128 x 2")
+    base.update(kw)
+    return SuiteRow(**base)
+
+
+def test_suite_table_markdown_and_html(tmp_path, rng):
+    c = build_comparison("<odd & name>", _runs(_image(), rng), _runs(_image(), rng))
+    rows = [suite_row(c, "odd"), _row("bad", "differ"),
+            SuiteRow(scene="broken", verdict="error", folder="broken", error="render failed: x")]
+    table = suite_markdown(rows, thumbnails=False).splitlines()
+    assert table[0].startswith("| scene | verdict |") and len(table) == 5
+    assert table[3].startswith("| bad | **differ** |") and table[3].endswith("| 2.00 | 1.00 | 2.0 |")
+    assert "render failed: x" in table[4]
+    page = suite_html(rows)
+    assert "&lt;odd &amp; name&gt;" in page and "<odd" not in page
+    assert '<td class="differ">differ</td>' in page and '<td class="error">error</td>' in page
+    paths = write_suite(rows, tmp_path)
+    assert json.loads(paths["summary.json"].read_text())["verdict"] == "error"
+    assert "3 scenes" in paths["summary.md"].read_text()
+
+
+def test_suite_verdict_is_differ_without_errors(tmp_path):
+    paths = write_suite([_row("a"), _row("b", "differ")], tmp_path)
+    assert json.loads(paths["summary.json"].read_text())["verdict"] == "differ"
+    assert math.isclose(json.loads(paths["summary.json"].read_text())["scenes"][0]["flip"], 0.02)

@@ -38,6 +38,10 @@ def default_session_factory(scene, threads=None):
 #: Callable ``(SceneDescription, threads=None) -> session``; tests replace it with a fake.
 session_factory = default_session_factory
 
+#: What the last render did, for the command line and tools: ``stats`` (the
+#: session's RenderStats), ``pixels``, ``export_seconds``, ``accounting`` (one line).
+last_render: dict = {}
+
 
 class MCEngine(bpy.types.RenderEngine):
     """Final renders with mcengine (no viewport or preview rendering yet)."""
@@ -59,6 +63,7 @@ class MCEngine(bpy.types.RenderEngine):
         if session is None:
             return
         x0, y0, x1, y1 = desc.film.window
+        self._pixels = (x1 - x0) * (y1 - y0)
         result = self.begin_result(0, 0, x1 - x0, y1 - y0)
         progress = _Progress(desc.integrator.samples, desc.integrator.time_limit)
         try:
@@ -72,6 +77,7 @@ class MCEngine(bpy.types.RenderEngine):
             except Exception as exc:
                 self._fail(_describe(exc, "reading the image"), exc)
             self.end_result(result)
+            self._record(depsgraph.scene.original, session)
 
     # -- steps ---------------------------------------------------------------
     def _prepare(self, depsgraph):
@@ -85,6 +91,7 @@ class MCEngine(bpy.types.RenderEngine):
             self._fail(_describe(exc, "exporting the scene"), exc)
             return None, None
         seconds = time.perf_counter() - start
+        self._export_seconds = seconds
         log.info("scene exported in %.3f s", seconds)
         for warning in exported.scene.warnings:
             self.report({"WARNING"}, warning)
@@ -105,7 +112,21 @@ class MCEngine(bpy.types.RenderEngine):
         self._write_pixels(result, session)
         done = int(session.samples_done)
         self.update_progress(progress.fraction(done))
-        self.update_stats("", stats_line(done, progress.samples, getattr(session, "stats", None)))
+        self.update_stats("", stats_line(done, progress.samples, getattr(session, "stats", None),
+                                         self._pixels))
+
+    def _record(self, scene, session) -> None:
+        """Keep the last render's ray accounting for the panel and the command line."""
+        stats = getattr(session, "stats", None)
+        if stats is None or not hasattr(stats, "accounting"):
+            return
+        line = stats.accounting(self._pixels, self._export_seconds)
+        last_render.clear()
+        last_render.update(stats=stats, pixels=self._pixels, export_seconds=self._export_seconds,
+                           accounting=line)
+        settings = getattr(scene, "mcengine", None)
+        if settings is not None:
+            settings["last_accounting"] = line
 
     def _write_pixels(self, result, session) -> None:
         """Copy ``session.image()`` (top row first) into the Combined pass (bottom row first)."""
@@ -143,8 +164,9 @@ class _Progress:
         return min(fraction, 1.0)
 
 
-def stats_line(done: int, total: int, stats) -> str:
-    """Status-bar text, e.g. "Sample 12/64 | 3.1 Mrays/s | Remaining 00:04".
+def stats_line(done: int, total: int, stats, pixels: int = 0) -> str:
+    """Status-bar text, e.g. "Sample 12/64 | 3.1 Mrays/s | Rays/px 12 cam, 30 bounce, 25 shadow |
+    Remaining 00:04".
 
     Parts ``stats`` lacks (no ``rays_per_second`` or ``eta_seconds``, or a value
     that is not finite yet) are left out.
@@ -153,6 +175,11 @@ def stats_line(done: int, total: int, stats) -> str:
     rate = getattr(stats, "rays_per_second", None)
     if rate is not None and math.isfinite(rate) and rate > 0:
         parts.append(f"{rate / 1e6:.1f} Mrays/s")
+    per_pixel = getattr(stats, "rays_per_pixel", None)
+    if pixels > 0 and callable(per_pixel):
+        r = per_pixel(pixels)
+        parts.append(f"Rays/px {r['camera']:.0f} cam, {r['bounce']:.0f} bounce, "
+                     f"{r['shadow']:.0f} shadow")
     eta = getattr(stats, "eta_seconds", None)
     if eta is not None and math.isfinite(eta):
         parts.append(f"Remaining {_clock(eta)}")

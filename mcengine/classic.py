@@ -35,13 +35,13 @@ import numpy as np
 from .bsdf import (LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT, M_EMISSION, M_EMISSIVE, M_GLASS,
                    M_IOR, M_MIRROR, M_REFRACT, M_W_GLASS, M_W_MIRROR, M_W_REFRACT, bsdf_eval,
                    bsdf_has_lobes, bsdf_sample, fresnel_dielectric)
-from .integrator import (CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD, CFG_WORLD_CAMERA,
-                         CFG_LAMPS_HIT, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
-                         PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SHADOW_RAYS,
-                         clamp_light, emission_weight, generate_camera_rays, hit_distance,
-                         lamps_on_segment, local_frame, next_path_flags, power_heuristic,
-                         push_shadow, sample_light, set_ray, skip_self_hit, sun_light,
-                         surface_geometry)
+from .integrator import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD,
+                         CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
+                         PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS,
+                         ST_SHADOW_RAYS, clamp_light, emission_weight, generate_camera_rays,
+                         hit_distance, lamps_on_segment, local_frame, next_path_flags,
+                         past_self_hit, power_heuristic, push_shadow, sample_light, set_ray,
+                         sun_light, surface_geometry)
 from .intersect import offset_origin
 from .jit import device, kernel
 from .lights import L_PMF, pick_light
@@ -95,13 +95,14 @@ def _push_child(nx, n_next, st, i, key, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz
     nx.mis_pdf[n_next] = mis_pdf
     nx.self_prim[n_next] = p
     ox, oy, oz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
-    set_ray(nx, n_next, ox, oy, oz, wix, wiy, wiz, math.inf)
+    set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
+            ox, oy, oz, wix, wiy, wiz, math.inf)
     return n_next + 1
 
 
 @device
-def _copy_node(nx, n_next, st, i):
-    """Carry node i unchanged into the next generation (a re-traced ray)."""
+def _copy_node(nx, n_next, st, i, advance):
+    """Carry node i into the next generation, its ray moved ``advance`` forward."""
     nx.key[n_next] = st.key[i]
     nx.pixel[n_next] = st.pixel[i]
     nx.root[n_next] = st.root[i]
@@ -112,8 +113,10 @@ def _copy_node(nx, n_next, st, i):
     nx.flags[n_next] = st.flags[i]
     nx.mis_pdf[n_next] = st.mis_pdf[i]
     nx.self_prim[n_next] = st.self_prim[i]
-    set_ray(nx, n_next, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2],
-            st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2], st.ray_tmax[i])
+    dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+    set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
+            st.ray_o[i, 0] + advance * dx, st.ray_o[i, 1] + advance * dy,
+            st.ray_o[i, 2] + advance * dz, dx, dy, dz, st.ray_tmax[i] - advance)
     return n_next + 1
 
 
@@ -131,20 +134,23 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
     for i in range(start, end):
         p = prim[i]
-        if skip_self_hit(st, i, sc, p, stats):
-            n_next = _copy_node(nx, n_next, st, i)
+        ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        if p >= 0 and p == st.self_prim[i]:
+            stats[ST_SELF_HITS] += 1
+            n_next = _copy_node(nx, n_next, st, i,
+                                past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz))
             continue
         root = st.root[i]
         flags = st.flags[i]
         bounce = st.bounce[i]
         br, bg, bb = st.beta[i, 0], st.beta[i, 1], st.beta[i, 2]
-        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
-        t_hit, b1, b2 = hit_distance(st, i, sc, p)
+        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
         arrival_direct = bounce <= 1
 
         if lamps_hit:
             lr, lg, lb, passed = lamps_on_segment(
-                sc, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2], dx, dy, dz, t_hit, flags,
+                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
                 st.mis_pdf[i], True, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
                 _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
@@ -157,17 +163,18 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 _accumulate(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
                             arrival_direct, fcfg, stats)
             if n_lamps:
-                lr, lg, lb = sun_light(sc, dx, dy, dz, flags, st.mis_pdf[i], True)
+                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], True)
                 if lr + lg + lb > 0.0:
                     _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
             continue
         if sc.tri_area[p] <= 0.0:
             continue
         hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing = surface_geometry(
-            sc, p, b1, b2, dx, dy, dz)
+            sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
         if sc.materials[m, M_EMISSIVE] > 0.0:
-            w = emission_weight(sc, p, t_hit, cos_o_geo, flags, st.mis_pdf[i], emit_scale)
+            w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
+                                st.mis_pdf[i], emit_scale)
             _accumulate(acc, root, br * sc.materials[m, M_EMISSION] * w,
                         bg * sc.materials[m, M_EMISSION + 1] * w,
                         bb * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
@@ -194,7 +201,9 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                     pmf = sc.emit_pmf[j] * emit_scale
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
                 (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
-                 lnx, lny, lnz) = sample_light(sc, idx, pmf, hx, hy, hz, bounce,
+                 lnx, lny, lnz) = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris,
+                                               sc.tri_normal, sc.tri_area, sc.mat_index,
+                                               sc.materials, idx, pmf, hx, hy, hz, bounce,
                                                rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V))
                 if lr + lg + lb <= 0.0 or wix * ngx + wiy * ngy + wiz * ngz <= 0.0:
                     continue
@@ -208,8 +217,9 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
                 cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
                 if cast_shadow:
-                    n_shadow = push_shadow(sq, n_shadow, root, hx, hy, hz, ngx, ngy, ngz,
-                                           wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb)
+                    n_shadow = push_shadow(sq.o32, sq.d32, sq.t32, sq.contrib, sq.path, n_shadow,
+                                           root, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, dist,
+                                           lnx, lny, lnz, cr, cg, cb)
                 else:
                     acc[root, 0] += cr
                     acc[root, 1] += cg

@@ -220,12 +220,12 @@ def clamp_light(r, g, b, limit, stats):
 
 
 @device
-def _add(st, i, r, g, b, direct, fcfg, stats):
+def _add(radiance, i, r, g, b, direct, fcfg, stats):
     limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
     r, g, b = clamp_light(r, g, b, limit, stats)
-    st.radiance[i, 0] += r
-    st.radiance[i, 1] += g
-    st.radiance[i, 2] += b
+    radiance[i, 0] += r
+    radiance[i, 1] += g
+    radiance[i, 2] += b
 
 
 @device
@@ -258,48 +258,40 @@ def nee_exclude(lamp_flags):
 
 
 @device
-def set_ray(st, i, ox, oy, oz, dx, dy, dz, tmax):
-    st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2] = ox, oy, oz
-    st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2] = dx, dy, dz
-    st.ray_tmax[i] = tmax
-    st.o32[i, 0], st.o32[i, 1], st.o32[i, 2] = ox, oy, oz
-    st.d32[i, 0], st.d32[i, 1], st.d32[i, 2] = dx, dy, dz
-    st.t32[i] = min(tmax, T_INFINITE)
+def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tmax):
+    """Write ray i (float64 and Embree's float32 copies)."""
+    ray_o[i, 0], ray_o[i, 1], ray_o[i, 2] = ox, oy, oz
+    ray_d[i, 0], ray_d[i, 1], ray_d[i, 2] = dx, dy, dz
+    ray_tmax[i] = tmax
+    o32[i, 0], o32[i, 1], o32[i, 2] = ox, oy, oz
+    d32[i, 0], d32[i, 1], d32[i, 2] = dx, dy, dz
+    t32[i] = min(tmax, T_INFINITE)
 
 
 @device
-def skip_self_hit(st, i, sc, p, stats):
-    """Handle a spurious re-hit of the triangle the ray left; True if it was one.
+def past_self_hit(verts, tris, p, ox, oy, oz, dx, dy, dz):
+    """Distance to move a ray that re-hit the triangle it left, to just past that hit.
 
     Triangles are flat, so a ray leaving one can only hit it again through
     rounding: the ray continues from just past that hit.
     """
-    if p < 0 or p != st.self_prim[i]:
-        return False
-    stats[ST_SELF_HITS] += 1
-    ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
-    dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
-    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
+    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p)
     if not math.isfinite(t) or t < 0.0:
         t = 0.0
-    s = offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
-    set_ray(st, i, ox + (t + s) * dx, oy + (t + s) * dy, oz + (t + s) * dz, dx, dy, dz,
-            st.ray_tmax[i] - t - s)
-    return True
+    return t + offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
 
 
 @device
-def hit_distance(st, i, sc, p):
-    """(t, b1, b2) of the ray's hit on triangle p (t = ray_tmax if p < 0)."""
+def hit_distance(verts, tris, p, ox, oy, oz, dx, dy, dz, tmax):
+    """(t, b1, b2) of the ray's hit on triangle p (t = tmax if p < 0)."""
     if p < 0:
-        return st.ray_tmax[i], 0.0, 0.0
-    t, b1, b2 = intersect_prim(st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2],
-                               st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2], sc.verts, sc.tris, p)
+        return tmax, 0.0, 0.0
+    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p)
     return (t if (math.isfinite(t) and t > 0.0) else 0.0), b1, b2
 
 
 @device
-def surface_geometry(sc, p, b1, b2, dx, dy, dz):
+def surface_geometry(verts, tris, tri_normal, normals, p, b1, b2, dx, dy, dz):
     """Hit point, geometric and shading normals facing the ray, and the side hit.
 
     Returns ``(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing)``.
@@ -308,14 +300,14 @@ def surface_geometry(sc, p, b1, b2, dx, dy, dz):
     the winding, or to the shading normals where they disagree with it).
     """
     b0 = 1.0 - b1 - b2
-    va, vb, vc = sc.tris[p, 0], sc.tris[p, 1], sc.tris[p, 2]
-    hx = b0 * sc.verts[va, 0] + b1 * sc.verts[vb, 0] + b2 * sc.verts[vc, 0]
-    hy = b0 * sc.verts[va, 1] + b1 * sc.verts[vb, 1] + b2 * sc.verts[vc, 1]
-    hz = b0 * sc.verts[va, 2] + b1 * sc.verts[vb, 2] + b2 * sc.verts[vc, 2]
-    ngx, ngy, ngz = sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2]
-    nsx = b0 * sc.normals[p, 0, 0] + b1 * sc.normals[p, 1, 0] + b2 * sc.normals[p, 2, 0]
-    nsy = b0 * sc.normals[p, 0, 1] + b1 * sc.normals[p, 1, 1] + b2 * sc.normals[p, 2, 1]
-    nsz = b0 * sc.normals[p, 0, 2] + b1 * sc.normals[p, 1, 2] + b2 * sc.normals[p, 2, 2]
+    va, vb, vc = tris[p, 0], tris[p, 1], tris[p, 2]
+    hx = b0 * verts[va, 0] + b1 * verts[vb, 0] + b2 * verts[vc, 0]
+    hy = b0 * verts[va, 1] + b1 * verts[vb, 1] + b2 * verts[vc, 1]
+    hz = b0 * verts[va, 2] + b1 * verts[vb, 2] + b2 * verts[vc, 2]
+    ngx, ngy, ngz = tri_normal[p, 0], tri_normal[p, 1], tri_normal[p, 2]
+    nsx = b0 * normals[p, 0, 0] + b1 * normals[p, 1, 0] + b2 * normals[p, 2, 0]
+    nsy = b0 * normals[p, 0, 1] + b1 * normals[p, 1, 1] + b2 * normals[p, 2, 1]
+    nsz = b0 * normals[p, 0, 2] + b1 * normals[p, 1, 2] + b2 * normals[p, 2, 2]
     ln = math.sqrt(nsx * nsx + nsy * nsy + nsz * nsz)
     if ln > 0.0 and math.isfinite(ln):
         nsx, nsy, nsz = nsx / ln, nsy / ln, nsz / ln
@@ -335,7 +327,7 @@ def surface_geometry(sc, p, b1, b2, dx, dy, dz):
 
 
 @device
-def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_light,
+def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_light,
                      transparent_left):
     """Light from lamps the ray passes through before t_hit (lamps do not block rays).
 
@@ -348,7 +340,7 @@ def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_li
     lr_sum = lg_sum = lb_sum = 0.0
     passed = 0
     last_t = 0.0
-    n_lamps = sc.lamps.shape[0]
+    n_lamps = lamps.shape[0]
     more = True
     while more and passed < transparent_left:
         best_t = t_hit
@@ -356,9 +348,9 @@ def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_li
         n_hits = 0
         br = bg = bb = bpdf = 0.0
         for li in range(n_lamps):
-            if not lamp_visible_to_ray(flags, int(sc.lamps[li, L_FLAGS])):
+            if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
                 continue
-            tl, lr, lg, lb, lpdf = intersect_lamp(sc.lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
+            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
             if tl > last_t and tl < t_hit:
                 n_hits += 1
                 if tl < best_t:
@@ -368,7 +360,7 @@ def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_li
             break
         w = 1.0
         if not (flags & PF_MIS_SKIP):
-            pmf = 1.0 if every_light else sc.lamps[best, L_PMF]
+            pmf = 1.0 if every_light else lamps[best, L_PMF]
             w = power_heuristic(mis_pdf, pmf * bpdf)
         lr_sum += br * w
         lg_sum += bg * w
@@ -380,20 +372,20 @@ def lamps_on_segment(sc, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_li
 
 
 @device
-def sun_light(sc, dx, dy, dz, flags, mis_pdf, every_light):
+def sun_light(lamps, dx, dy, dz, flags, mis_pdf, every_light):
     """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
     r = g = b = 0.0
-    for li in range(sc.lamps.shape[0]):
-        if int(sc.lamps[li, L_TYPE]) != LT_SUN or sc.lamps[li, L_SUN_COS] >= 1.0:
+    for li in range(lamps.shape[0]):
+        if int(lamps[li, L_TYPE]) != LT_SUN or lamps[li, L_SUN_COS] >= 1.0:
             continue
-        lflags = int(sc.lamps[li, L_FLAGS])
+        lflags = int(lamps[li, L_FLAGS])
         if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):
             continue
-        lr, lg, lb, lpdf = sun_radiance(sc.lamps, li, dx, dy, dz)
+        lr, lg, lb, lpdf = sun_radiance(lamps, li, dx, dy, dz)
         if lpdf > 0.0:
             w = 1.0
             if not (flags & PF_MIS_SKIP):
-                pmf = 1.0 if every_light else sc.lamps[li, L_PMF]
+                pmf = 1.0 if every_light else lamps[li, L_PMF]
                 w = power_heuristic(mis_pdf, pmf * lpdf)
             r += lr * w
             g += lg * w
@@ -402,19 +394,21 @@ def sun_light(sc, dx, dy, dz, flags, mis_pdf, every_light):
 
 
 @device
-def emission_weight(sc, p, t_hit, cos_o_geo, flags, mis_pdf, emit_pmf_scale):
+def emission_weight(tri_light, emit_pmf, tri_area, p, t_hit, cos_o_geo, flags, mis_pdf,
+                    emit_pmf_scale):
     """MIS weight of emission found by a BSDF ray on emissive triangle p."""
     if flags & PF_MIS_SKIP:
         return 1.0
-    j = sc.tri_light[p]
+    j = tri_light[p]
     if j < 0:
         return 1.0
-    light_pdf = sc.emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (sc.tri_area[p] * cos_o_geo)
+    light_pdf = emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (tri_area[p] * cos_o_geo)
     return power_heuristic(mis_pdf, light_pdf)
 
 
 @device
-def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2):
+def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, materials,
+                 idx, pmf, hx, hy, hz, bounce, u1, u2):
     """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h.
 
     ``pmf`` is the probability with which the caller chose this light.
@@ -425,12 +419,12 @@ def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2):
     emitter's unit normal (zero for lamps) for offsetting the shadow ray's end.
     All-zero radiance means no contribution.
     """
-    n_lamps = sc.lamps.shape[0]
+    n_lamps = lamps.shape[0]
     if idx < n_lamps:
-        lflags = int(sc.lamps[idx, L_FLAGS])
-        if bounce > sc.lamps[idx, L_MAX_BOUNCES]:
+        lflags = int(lamps[idx, L_FLAGS])
+        if bounce > lamps[idx, L_MAX_BOUNCES]:
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
-        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(sc.lamps, idx, hx, hy, hz, u1, u2)
+        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamps, idx, hx, hy, hz, u1, u2)
         use_mis = (lflags & LF_USE_MIS) != 0
         if pdf > 0.0:
             pdf_l = pmf * pdf
@@ -441,28 +435,28 @@ def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2):
             lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
         return (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, (lflags & LF_CAST_SHADOW) != 0,
                 nee_exclude(lflags), 0.0, 0.0, 0.0)
-    tri = sc.emit_tri[idx - n_lamps]
-    qx, qy, qz = sample_triangle_point(sc.verts, sc.tris, tri, u1, u2)
+    tri = emit_tri[idx - n_lamps]
+    qx, qy, qz = sample_triangle_point(verts, tris, tri, u1, u2)
     lx, ly, lz = qx - hx, qy - hy, qz - hz
     d2 = lx * lx + ly * ly + lz * lz
     dist = math.sqrt(d2)
     if dist <= 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
     wix, wiy, wiz = lx / dist, ly / dist, lz / dist
-    lnx, lny, lnz = sc.tri_normal[tri, 0], sc.tri_normal[tri, 1], sc.tri_normal[tri, 2]
+    lnx, lny, lnz = tri_normal[tri, 0], tri_normal[tri, 1], tri_normal[tri, 2]
     cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
     if cos_l <= 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0
-    pdf_l = pmf * d2 / (sc.tri_area[tri] * cos_l)
-    em = sc.mat_index[tri]
-    return (wix, wiy, wiz, dist, sc.materials[em, M_EMISSION] / pdf_l,
-            sc.materials[em, M_EMISSION + 1] / pdf_l, sc.materials[em, M_EMISSION + 2] / pdf_l,
+    pdf_l = pmf * d2 / (tri_area[tri] * cos_l)
+    em = mat_index[tri]
+    return (wix, wiy, wiz, dist, materials[em, M_EMISSION] / pdf_l,
+            materials[em, M_EMISSION + 1] / pdf_l, materials[em, M_EMISSION + 2] / pdf_l,
             pdf_l, True, True, 0, lnx, lny, lnz)
 
 
 @device
-def push_shadow(sq, n_shadow, owner, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, dist,
-                lnx, lny, lnz, cr, cg, cb):
+def push_shadow(so32, sd32, st32, scontrib, spath, n_shadow, owner, hx, hy, hz, ngx, ngy, ngz,
+                wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb):
     """Queue a shadow ray from h towards the light point; returns the new queue length.
 
     Both ends leave their surfaces (pbrt's SpawnRayTo): the direction is
@@ -480,11 +474,11 @@ def push_shadow(sq, n_shadow, owner, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, d
         length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
         sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
         tmax = length * (1.0 - SHADOW_SHORTEN)
-    sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
-    sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = sdx, sdy, sdz
-    sq.t32[n_shadow] = tmax
-    sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
-    sq.path[n_shadow] = owner
+    so32[n_shadow, 0], so32[n_shadow, 1], so32[n_shadow, 2] = sox, soy, soz
+    sd32[n_shadow, 0], sd32[n_shadow, 1], sd32[n_shadow, 2] = sdx, sdy, sdz
+    st32[n_shadow] = tmax
+    scontrib[n_shadow, 0], scontrib[n_shadow, 1], scontrib[n_shadow, 2] = cr, cg, cb
+    spath[n_shadow] = owner
     return n_shadow + 1
 
 
@@ -523,21 +517,26 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
-        if skip_self_hit(st, i, sc, p, stats):
+        ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        if p >= 0 and p == st.self_prim[i]:
+            stats[ST_SELF_HITS] += 1
+            s = past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz)
+            set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+                    ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, st.ray_tmax[i] - s)
             st.alive[i] = 1
             continue
         flags = st.flags[i]
-        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
-        t_hit, b1, b2 = hit_distance(st, i, sc, p)
+        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
         arrival_direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
 
         # -- lamps along the ray ---------------------------------------------------------
         if lamps_hit:
             lr, lg, lb, passed = lamps_on_segment(
-                sc, st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2], dx, dy, dz, t_hit, flags,
+                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
                 st.mis_pdf[i], False, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
-                _add(st, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
+                _add(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                      arrival_direct, fcfg, stats)
                 st.transparent[i] += passed
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
@@ -548,12 +547,12 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             if flags & PF_TRANSPARENT_BG:
                 st.transparency[i] = 1.0
             elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
-                _add(st, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
+                _add(st.radiance, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
                      st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
             if n_lamps:
-                lr, lg, lb = sun_light(sc, dx, dy, dz, flags, st.mis_pdf[i], False)
+                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], False)
                 if lr + lg + lb > 0.0:
-                    _add(st, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
+                    _add(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                          arrival_direct, fcfg, stats)
             continue
 
@@ -561,7 +560,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
         hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing = surface_geometry(
-            sc, p, b1, b2, dx, dy, dz)
+            sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
 
         # Russian roulette (Cycles: from the third vertex on, with the
@@ -572,8 +571,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # Emission (two-sided).
         if sc.materials[m, M_EMISSIVE] > 0.0:
-            w = emission_weight(sc, p, t_hit, cos_o_geo, flags, st.mis_pdf[i], 1.0)
-            _add(st, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
+            w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
+                                st.mis_pdf[i], 1.0)
+            _add(st.radiance, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
                  st.beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
                  st.beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
 
@@ -594,7 +594,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             idx = pick_light(sc.light_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_PICK)))
             pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
             (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
-             lnx, lny, lnz) = sample_light(sc, idx, pmf, hx, hy, hz, bounce,
+             lnx, lny, lnz) = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal,
+                                           sc.tri_area, sc.mat_index, sc.materials, idx, pmf,
+                                           hx, hy, hz, bounce,
                                            rand(key, bounce_dim(bounce, DIM_LIGHT_U)),
                                            rand(key, bounce_dim(bounce, DIM_LIGHT_V)))
             if lr + lg + lb > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
@@ -609,8 +611,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
                     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
                     if cast_shadow:
-                        n_shadow = push_shadow(sq, n_shadow, i, hx, hy, hz, ngx, ngy, ngz,
-                                               wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb)
+                        n_shadow = push_shadow(sq.o32, sq.d32, sq.t32, sq.contrib, sq.path, n_shadow, i,
+                                               hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, dist,
+                                               lnx, lny, lnz, cr, cg, cb)
                     else:
                         st.radiance[i, 0] += cr
                         st.radiance[i, 1] += cg
@@ -654,7 +657,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         st.flags[i] = new_flags
         st.mis_pdf[i] = pdf
         nox, noy, noz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
-        set_ray(st, i, nox, noy, noz, wix, wiy, wiz, math.inf)
+        set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+                nox, noy, noz, wix, wiy, wiz, math.inf)
         st.self_prim[i] = p
         st.alive[i] = 1
     return n_shadow

@@ -8,8 +8,13 @@
 * ``nogil=True`` on stage kernels: two Python worker threads run them in
   parallel (no OpenMP pool whose spinning workers would steal the core that
   Embree runs on).
+* ``inline="always"`` on device functions (everything a kernel calls): a
+  call numba does not inline costs 15-40 ns (its calling convention passes
+  every array as a struct and checks an error status), which summed over the
+  dozen helpers of a shading step made it several times slower.  Kernels
+  compile more slowly; the cache keeps that a one-off.
 """
 from numba import njit
 
-device = njit(cache=True, error_model="numpy")
+device = njit(cache=True, error_model="numpy", inline="always")
 kernel = njit(cache=True, nogil=True, error_model="numpy")

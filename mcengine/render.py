@@ -86,6 +86,22 @@ class RenderStats:
         return {"camera": self.camera_rays / p, "bounce": self.bounce_rays / p,
                 "shadow": self.shadow_rays / p}
 
+    def phases(self, time_export: float = 0.0) -> dict:
+        """Seconds per phase; tracing and shading are summed over the worker threads."""
+        return {"export": time_export, "bvh": self.time_bvh, "kernels": self.time_kernels,
+                "tracing": self.time_embree, "shading": max(self.time_workers - self.time_embree, 0.0),
+                "render": self.time_render}
+
+    def accounting(self, pixels: int, time_export: float = 0.0) -> str:
+        """One line: rays per pixel by kind, Mrays/s, time per phase."""
+        r = self.rays_per_pixel(pixels)
+        t = self.phases(time_export)
+        return (f"rays/pixel: camera {r['camera']:.1f}, bounce {r['bounce']:.1f}, "
+                f"shadow {r['shadow']:.1f} | {self.rays_per_second / 1e6:.2f} Mrays/s | "
+                f"export {t['export']:.2f} s, BVH {t['bvh']:.2f} s, kernels {t['kernels']:.2f} s, "
+                f"tracing {t['tracing']:.2f} s, shading {t['shading']:.2f} s (thread-seconds), "
+                f"wall {t['render']:.2f} s")
+
 
 class _TimedAccel:
     """Accel wrapper that adds the time spent in Embree to a worker's counter."""

@@ -8,6 +8,7 @@ written to a temporary 32-bit EXR (the scene-linear values) and read back.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 import time
@@ -56,6 +57,50 @@ def make_unbiased(scene):
     c.blur_glossy = 0.0
     c.device = "CPU"
     scene.view_settings.view_transform = "Standard"
+
+
+# Every scene setting that make_unbiased, render_scene and the comparison
+# (mcengine_blender.comparison) change, as (owner path from the scene, attribute).
+# Restored in this order: the image format before its colour mode and depth
+# (a format change resets them), the view transform before the look.
+TOUCHED_SETTINGS = (
+    ("render", "engine"), ("render", "resolution_x"), ("render", "resolution_y"),
+    ("render", "resolution_percentage"), ("render", "filepath"), ("render", "use_file_extension"),
+    ("render.image_settings", "media_type"), ("render.image_settings", "file_format"),
+    ("render.image_settings", "color_mode"), ("render.image_settings", "color_depth"),
+    ("cycles", "samples"), ("cycles", "seed"), ("cycles", "use_denoising"),
+    ("cycles", "use_adaptive_sampling"), ("cycles", "sample_clamp_direct"),
+    ("cycles", "sample_clamp_indirect"), ("cycles", "blur_glossy"), ("cycles", "device"),
+    ("cycles", "time_limit"), ("cycles", "use_layer_samples"),
+    ("view_settings", "view_transform"), ("view_settings", "look"),
+    ("mcengine", "integrator"),
+)
+
+
+def _owner(scene, path: str):
+    """The settings struct at ``path`` (None if absent, e.g. add-on not registered)."""
+    owner = scene
+    for name in path.split("."):
+        owner = getattr(owner, name, None)
+    return owner
+
+
+@contextlib.contextmanager
+def restoring(scene):
+    """Put back every setting of :data:`TOUCHED_SETTINGS` on exit (also on errors).
+
+    Lets the comparison render the user's open scene with other settings and
+    leave it as it was.  (The Render Result image keeps the last render.)
+    """
+    saved = [(path, name, getattr(_owner(scene, path), name)) for path, name in TOUCHED_SETTINGS
+             if hasattr(_owner(scene, path), name)]
+    try:
+        yield scene
+    finally:
+        for path, name, value in saved:
+            owner = _owner(scene, path)
+            if getattr(owner, name) != value:
+                setattr(owner, name, value)
 
 
 def render_scene(scene, engine: str, *, samples=None, seed=None, resolution=None) -> Render:

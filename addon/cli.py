@@ -1,4 +1,4 @@
-"""Command line: render a .blend file headless with MC Engine or Cycles.
+"""Command line: render a .blend file headless with MC Engine or Cycles, or compare the two.
 
 Two spellings take the same options::
 
@@ -9,12 +9,20 @@ Two spellings take the same options::
 The second one is Blender's own background-render syntax (``-b -E -o -f -F -S -t``
 and their long forms), so ``blender -b`` scripts carry over unchanged.
 
+``compare`` renders a scene with both engines and tests whether they agree
+(see ``mcengine_blender.comparison`` and ``mcengine.report``)::
+
+    mcengine compare SCENE.blend [--samples N] [--resolution WxH|P%] [--seeds K] [--out DIR]
+    mcengine compare --suite FOLDER [same options]      # every .blend in FOLDER, one summary
+
 Conventions
 -----------
 * Every argument, the input file (its magic bytes) and the output folders are
   checked before ``bpy`` is imported, so bad input fails in well under a second.
 * Failures are one line on stderr, ``mcengine: error: ...``, never a traceback.
-  Exit status: 0 rendered, 1 the render (or file loading) failed, 2 bad input.
+  Exit status: 0 rendered, 1 the render (or file loading) failed, 2 bad input;
+  ``compare`` exits 0 when the engines agree and 3 when they differ (1 and 2 as
+  above; in a suite, any failed scene gives 1, else any difference 3).
 * Output paths follow Blender: ``//`` is the .blend file's folder, the last run
   of ``#`` in the file name becomes the zero-padded frame number, and the
   format's extension is appended when the name has none.  ``-o`` may be given
@@ -31,7 +39,8 @@ Conventions
   (``bpy.app.handlers.render_stats``), which Cycles reports and which a Python
   engine reports through ``RenderEngine.update_stats``; ``update_progress`` does
   not reach Python handlers in Blender 5.0.
-* The only thing written to stdout is the path of each saved image.
+* The only thing written to stdout is the path of each saved image (``compare``:
+  the path of each ``report.json``, or of ``summary.json`` for a suite).
 """
 from __future__ import annotations
 
@@ -53,6 +62,7 @@ PROG = "mcengine"
 EXIT_OK = 0
 EXIT_RENDER_FAILED = 1
 EXIT_BAD_INPUT = 2
+EXIT_DIFFER = 3
 EXIT_INTERRUPTED = 130
 
 # User-facing engine names -> RenderEngine bl_idname.
@@ -74,6 +84,13 @@ MAX_SAMPLES = 16_777_216
 MAX_SEED = 2_147_483_647
 MAX_FRAME = 1_048_574
 MAX_THREADS = 1024
+# compare: renders per engine.  Two is the minimum that estimates the noise;
+# more than this is never needed (the test pools every pixel's variance).
+DEFAULT_SEEDS, MAX_SEEDS = 2, 64
+MAX_PERCENTAGE = 1000
+DEFAULT_ALPHA = 1e-3
+# The comparison tests an 8x8 grid of blocks, so each side needs 8 pixels.
+MIN_COMPARE_SIZE = 8
 
 # A .blend starts with "BLENDER"; Blender 3.0+ may zstd-compress the whole file,
 # older versions gzip it.
@@ -211,7 +228,69 @@ def build_parser() -> argparse.ArgumentParser:
                         help="CPU threads, 0 = all (default: the file's setting)")
     render.add_argument("--verbose", action="store_true",
                         help="show Blender's own log and tracebacks")
+    _add_compare_parser(commands)
     return parser
+
+
+def _add_compare_parser(commands) -> None:
+    compare = commands.add_parser(
+        "compare", help="render with MC Engine and Cycles and test whether they agree",
+        description="Render a scene with MC Engine and with Cycles under matched, unbiased "
+                    "settings, K seeds each, and test whether the two agree within their noise. "
+                    "Writes mcengine.exr, cycles.exr, side_by_side.png, report.json and report.md. "
+                    "Exit status 0: agree, 3: differ.")
+    compare.add_argument("blendfile", metavar="SCENE.blend", nargs="?", default=None,
+                         help="the file to compare (or use --suite)")
+    compare.add_argument("--suite", metavar="FOLDER", default=None,
+                         help="compare every .blend in FOLDER and write summary.md/.html/.json")
+    compare.add_argument("--samples", type=_samples, default=None,
+                         help="samples per pixel and render (default: the file's Cycles samples)")
+    compare.add_argument("--resolution", type=_compare_resolution, default=None, metavar="WxH|P%",
+                         help="image size in pixels, or a percentage of the file's size "
+                              "(default: the file's size and percentage)")
+    compare.add_argument("--seeds", type=_seeds, default=DEFAULT_SEEDS, metavar="K",
+                         help=f"renders per engine, {2}..{MAX_SEEDS} (default {DEFAULT_SEEDS})")
+    compare.add_argument("--alpha", type=_alpha, default=DEFAULT_ALPHA,
+                         help=f"false-alarm rate of the verdict over all its tests "
+                              f"(default {DEFAULT_ALPHA:g})")
+    compare.add_argument("--out", metavar="DIR", default=None,
+                         help="output folder, created if missing "
+                              "(default: ./compare-SCENE, or ./compare-suite)")
+    compare.add_argument("-S", "--scene", default=None,
+                         help="scene to compare (default: the file's active scene)")
+    compare.add_argument("-t", "--threads", type=_threads, default=None,
+                         help="CPU threads, 0 = all (default: the file's setting)")
+    compare.add_argument("--verbose", action="store_true",
+                         help="show Blender's own log and tracebacks")
+
+
+def _compare_resolution(text: str):
+    """``WxH`` -> ("size", (w, h)); ``P%`` -> ("percent", P)."""
+    match = re.fullmatch(r"\s*(\d+)\s*%\s*", text)
+    if match is None:
+        return "size", _resolution(text)
+    percent = int(match[1])
+    if not 1 <= percent <= MAX_PERCENTAGE:
+        raise argparse.ArgumentTypeError(
+            f"resolution percentage must be between 1 and {MAX_PERCENTAGE}, got {percent}")
+    return "percent", percent
+
+
+def _seeds(text: str) -> int:
+    value = _positive_int(text, "seed count", MAX_SEEDS)
+    if value < 2:
+        raise argparse.ArgumentTypeError("at least 2 seeds are needed to estimate the noise, got 1")
+    return value
+
+
+def _alpha(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"alpha must be a number, got {text!r}") from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"alpha must lie strictly between 0 and 1, got {value:g}")
+    return value
 
 
 def _version() -> str:
@@ -334,7 +413,71 @@ def check_output_folder(path: Path) -> None:
         raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
 
 
-def parse_args(argv: list[str]) -> RenderRequest | None:
+@dataclass(frozen=True)
+class CompareRequest:
+    """A validated ``compare`` command line: ``blendfile`` or ``suite`` is set."""
+
+    blendfile: Path | None
+    suite: Path | None
+    out: Path
+    samples: int | None
+    resolution: tuple[int, int] | None
+    percentage: int | None
+    seeds: int
+    alpha: float
+    scene: str | None
+    threads: int | None
+    verbose: bool
+
+
+def prepare_output_folder(folder: Path) -> None:
+    """Create ``folder`` (and its parents) if needed; raise CliError unless it is writable."""
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"output path is not a folder: {folder}")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
+
+
+def _compare_request(args) -> CompareRequest:
+    if (args.blendfile is None) == (args.suite is None):
+        raise CliError("give either SCENE.blend or --suite FOLDER "
+                       f"(try '{PROG} compare SCENE.blend' or '{PROG} compare --suite blend_scenes/')")
+    blendfile = suite = None
+    if args.suite is not None:
+        suite = Path(args.suite).absolute()
+        if not suite.is_dir():
+            raise CliError(f"suite folder not found: {suite}" if not suite.exists()
+                           else f"--suite needs a folder, not a file: {suite}")
+        files = sorted(suite.glob("*.blend"))
+        if not files:
+            raise CliError(f"no .blend files in {suite}")
+        for path in files:
+            check_blend_file(path)
+        if args.scene is not None:
+            raise CliError("-S/--scene names one scene of one file; it cannot be used with --suite")
+        default_out = "compare-suite"
+    else:
+        blendfile = Path(args.blendfile).absolute()
+        check_blend_file(blendfile)
+        default_out = f"compare-{blendfile.stem}"
+    out = Path(args.out if args.out is not None else default_out).absolute()
+    prepare_output_folder(out)
+    kind, value = args.resolution if args.resolution is not None else (None, None)
+    if kind == "size" and min(value) < MIN_COMPARE_SIZE:
+        raise CliError(f"resolution {value[0]}x{value[1]} is too small for the comparison's "
+                       f"{MIN_COMPARE_SIZE}x{MIN_COMPARE_SIZE} block grid")
+    return CompareRequest(
+        blendfile=blendfile, suite=suite, out=out, samples=args.samples,
+        resolution=value if kind == "size" else None,
+        percentage=value if kind == "percent" else None, seeds=args.seeds, alpha=args.alpha,
+        scene=args.scene, threads=args.threads, verbose=args.verbose)
+
+
+def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | None:
     """Validate the command line; None means help/version was printed."""
     if any(arg in ("-b", "--background") for arg in argv):
         argv = _blender_style(argv)
@@ -347,6 +490,8 @@ def parse_args(argv: list[str]) -> RenderRequest | None:
         if exc.code:
             raise
         return None
+    if args.command == "compare":
+        return _compare_request(args)
     blendfile = Path(args.blendfile).absolute()
     check_blend_file(blendfile)
     raw_outputs = args.outputs or [f"{blendfile.stem}{FORMATS[args.format or DEFAULT_FORMAT]}"]
@@ -632,6 +777,113 @@ def run(request: RenderRequest) -> int:
     return EXIT_OK
 
 
+def _import_bpy_with_addon():
+    try:
+        import bpy
+    except ImportError as exc:
+        raise CliError(f"cannot import bpy (Blender 5.0 as a Python module): {exc}",
+                       EXIT_RENDER_FAILED) from None
+    _register_addon()
+    return bpy
+
+
+class _CompareRenderer:
+    """``render`` for the comparison: a progress bar per render, the engine's log checked.
+
+Called while Blender's log is captured (the whole comparison runs inside
+``BlenderLog.capture``); the progress bar goes to the real stderr.
+
+    An engine's crash (a traceback in the log) is raised as RuntimeError, which
+    the comparison reports as a failed render.
+    """
+
+    def __init__(self, bpy, log: BlenderLog, threads: int | None):
+        self.bpy = bpy
+        self.log = log
+        self.threads = threads
+        self.label = ""
+        self.warnings: list[str] = []
+
+    def on_render(self, engine: str, index: int, total: int) -> None:
+        self.label = f"[{index + 1}/{total}] {engine}"
+
+    def __call__(self, scene, engine, **settings):
+        from .batch import render_scene
+        if self.threads is not None:
+            scene.render.threads_mode = "AUTO" if self.threads == 0 else "FIXED"
+            if self.threads:
+                scene.render.threads = self.threads
+        progress = Progress(self.log.console, self.label or engine)
+        start = self.log.mark()
+        self.bpy.app.handlers.render_stats.append(progress.on_stats)
+        try:
+            result = render_scene(scene, engine, **settings)
+        finally:
+            self.bpy.app.handlers.render_stats.remove(progress.on_stats)
+            progress.finish()
+        text = self.log.text(since=start)
+        crash = engine_traceback(text)
+        if crash is not None:
+            raise RuntimeError(f"{engine} raised {crash}")
+        for warning in warning_lines(text):
+            if warning not in self.warnings:
+                self.warnings.append(warning)
+        return result
+
+
+def _compare_options(request: CompareRequest):
+    from .comparison import CompareOptions
+    return CompareOptions(samples=request.samples, resolution=request.resolution,
+                          percentage=request.percentage, seeds=request.seeds, alpha=request.alpha)
+
+
+def run_compare(request: CompareRequest) -> int:
+    """Compare one file or a suite; returns the exit status (0 agree, 3 differ)."""
+    log = BlenderLog(passthrough=request.verbose)
+    with log.capture():
+        bpy = _import_bpy_with_addon()
+    from mcengine.report import write_comparison
+
+    from .comparison import CompareError, compare_file, run_suite
+    renderer = _CompareRenderer(bpy, log, request.threads)
+    options = _compare_options(request)
+    console = log.console
+    if request.suite is not None:
+        def on_scene(path, index, total):
+            console.write(f"{PROG}: comparing {path.name} ({index + 1}/{total})\n")
+
+        def on_done(row):
+            detail = row.error if row.verdict == "error" else (
+                f"relMSE {row.relmse:.3g}, FLIP {row.flip:.3f}, blocks differ {row.blocks_differ}")
+            console.write(f"{PROG}: {row.scene}: {row.verdict} ({detail})\n")
+
+        with log.capture():
+            rows, paths = run_suite(request.suite, options, request.out, render=renderer,
+                                    on_scene=on_scene, on_render=renderer.on_render,
+                                    on_done=on_done)
+        verdicts = {row.verdict for row in rows}
+        console.write(f"{PROG}: {sum(r.verdict == 'agree' for r in rows)}/{len(rows)} scenes agree; "
+                      f"summary in {paths['summary.md']} and {paths['summary.html']}\n")
+        print(paths["summary.json"])
+        if "error" in verdicts:
+            return EXIT_RENDER_FAILED
+        return EXIT_DIFFER if "differ" in verdicts else EXIT_OK
+    try:
+        with log.capture():
+            comparison = compare_file(request.blendfile, options, scene_name=request.scene,
+                                      render=renderer, on_render=renderer.on_render)
+            paths = write_comparison(comparison, request.out)
+    except CompareError as exc:
+        raise CliError(str(exc), EXIT_RENDER_FAILED) from None
+    for warning in renderer.warnings:
+        console.write(f"{PROG}: warning: {warning}\n")
+    console.write(f"{PROG}: {comparison.summary()}\n{PROG}: wrote " + ", ".join(
+        str(paths[name]) for name in ("side_by_side.png", "report.md", "mcengine.exr",
+                                      "cycles.exr")) + "\n")
+    print(paths["report.json"])
+    return EXIT_OK if comparison.verdict == "agree" else EXIT_DIFFER
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console entry point; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
@@ -640,6 +892,8 @@ def main(argv: list[str] | None = None) -> int:
         request = parse_args(argv)
         if request is None:
             return EXIT_OK
+        if isinstance(request, CompareRequest):
+            return run_compare(request)
         return run(request)
     except CliError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)

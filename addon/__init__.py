@@ -19,14 +19,16 @@ __all__ = ["register", "unregister"]
 
 
 def register() -> None:
-    from . import engine, properties, ui
+    from . import engine, operators, properties, ui
     properties.register()
     engine.register()
+    operators.register()
     ui.register()
 
 
 def unregister() -> None:
-    from . import engine, properties, ui
+    from . import engine, operators, properties, ui
     ui.unregister()
+    operators.unregister()
     engine.unregister()
     properties.unregister()

@@ -44,6 +44,7 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
 
     def draw(self, context):
         settings = context.scene.mcengine
+        self.layout.operator("mcengine.compare_with_cycles", icon="SEQ_SPLITVIEW")
         col = self.layout.column(align=True)
         if not settings.last_effects:
             col.label(text="Not rendered yet", icon="INFO")

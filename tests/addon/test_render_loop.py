@@ -90,8 +90,9 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
                                          "Ignored: specular, denoising"]
 
 
-def _panel_text(addon, scene):
-    """The labels the MC Engine render panel draws (with a recording stand-in layout)."""
+def _panel_text(addon, scene, operators=None):
+    """The labels the MC Engine render panel draws (with a recording stand-in layout);
+    the operator buttons' ids go to ``operators`` if given."""
     lines = []
 
     class Layout:
@@ -100,6 +101,10 @@ def _panel_text(addon, scene):
 
         def label(self, text="", **_):
             lines.append(text)
+
+        def operator(self, idname, **_):
+            if operators is not None:
+                operators.append(idname)
 
     panel = SimpleNamespace(layout=Layout())
     addon.ui.MCENGINE_RENDER_PT_engine.draw(panel, SimpleNamespace(scene=scene))

@@ -286,6 +286,17 @@ def add_uv_sphere(scene, name, radius, material, smooth=True,
     return add_mesh(scene, name, vertices, faces, material, smooth=smooth, **transform)
 
 
+def add_empty(scene, name, parent=None, **transform):
+    """Add an empty (a transform only), optionally parented; returns it.
+
+    With ``parent``, the transform is relative to the parent (the parent
+    inverse matrix stays identity, so world = parent world @ local).
+    """
+    obj = _link(scene, bpy.data.objects.new(name, None), **transform)
+    obj.parent = parent
+    return obj
+
+
 def look_at(obj, target):
     """Rotate ``obj`` so that its local -Z axis points at ``target`` (+Y stays up)."""
     direction = Vector(target) - Vector(obj.location)

@@ -22,6 +22,15 @@ SCENES = (
     "light_emissive_mesh",
     "world_color",
     "glass_mirror",
+    "light_area_spread",
+    "light_point_large",
+    "light_spot_shapes",
+    "light_sun_wide",
+    "transforms",
+    "instancing_modifiers",
+    "camera_sensor_fit",
+    "camera_portrait_wide",
+    "camera_ortho",
 )
 
 

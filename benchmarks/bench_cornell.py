@@ -80,8 +80,7 @@ def main(argv=None) -> int:
     med = {e: {k: statistics.median(v) for k, v in f.items()} for e, f in figures.items()}
     st = our_stats[-1]
     session = sessions[-1]
-    buffers = sum(a.nbytes for w in session._all_workers for a in (*w.state, *w.shadow))
-    buffers += sum(a.nbytes for a in session.film.arrays)
+    buffers = session.buffer_bytes
     print()
     print(f"Cornell box {args.resolution}x{args.resolution}, {args.samples} spp, 8 bounces, "
           f"medians of {args.rounds} rounds")

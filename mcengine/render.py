@@ -123,16 +123,53 @@ class _TimedAccel:
         return r
 
 
-class _Worker:
-    """Buffers and counters of one worker thread, allocated once per render."""
+class _Buffers:
+    """Wavefront buffers of one worker: allocated once, reused by later renders.
 
-    def __init__(self, batch, accel, classic=False):
+    Freshly mapped memory is slow on first touch on these machines (about
+    2 s per GB), so buffers go back to a pool when a render ends and the next
+    render of the same batch size takes them from there.
+    """
+
+    _pool: dict = {}
+    _pool_lock = threading.Lock()
+
+    def __init__(self, batch, classic):
+        self.key = (batch, classic)
         self.state = K.alloc_path_state(batch)
         self.shadow = K.alloc_shadow_queue(batch)
         if classic:   # a second generation of rays and per-camera-sample sums
             self.next_state = K.alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
             self.root_pixel = np.zeros(batch, np.int32)
+
+    @property
+    def nbytes(self) -> int:
+        arrays = [*self.state, *self.shadow]
+        if self.key[1]:
+            arrays += [*self.next_state, self.acc, self.root_pixel]
+        return sum(a.nbytes for a in arrays)
+
+    @classmethod
+    def take(cls, batch, classic) -> "_Buffers":
+        with cls._pool_lock:
+            free = cls._pool.get((batch, classic))
+            if free:
+                return free.pop()
+        return cls(batch, classic)
+
+    def give_back(self) -> None:
+        with self._pool_lock:
+            free = self._pool.setdefault(self.key, [])
+            if len(free) < default_threads():
+                free.append(self)
+
+
+class _Worker:
+    """One worker thread's buffers, counters and timers for one render."""
+
+    def __init__(self, buffers, accel):
+        self.buffers = buffers
         self.stats = np.zeros(K.ST_SIZE, np.int64)
         self.embree_clock = [0.0]
         self.busy = 0.0
@@ -243,6 +280,7 @@ class RenderSession:
         self._stop = threading.Event()
         self._workers = threading.local()
         self._all_workers = []
+        self._buffer_bytes = 0
         self._lock = threading.Lock()
 
     # -- public ------------------------------------------------------------------------
@@ -300,7 +338,22 @@ class RenderSession:
                 if self._stop.is_set():
                     break
         self._update_stats(t_start)
+        self._release_buffers()
         return self
+
+    def _release_buffers(self):
+        """Give the workers' buffers back to the pool (threads end with the run)."""
+        with self._lock:
+            for w in self._all_workers:
+                if w.buffers is not None:
+                    w.buffers.give_back()
+                    w.buffers = None
+        self._workers = threading.local()
+
+    @property
+    def buffer_bytes(self) -> int:
+        """Memory of the wavefront buffers and the film (bounded by batch size and resolution)."""
+        return sum(a.nbytes for a in self.film.arrays) + self._buffer_bytes
 
     # -- internals -----------------------------------------------------------------------
     def _classic_setup(self):
@@ -353,19 +406,21 @@ class RenderSession:
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(self.batch_size, self.accel, classic=self.method != "path")
+            w = _Worker(_Buffers.take(self.batch_size, self.method != "path"), self.accel)
             self._workers.w = w
+            self._buffer_bytes = max(self._buffer_bytes, self.threads * w.buffers.nbytes)
             with self._lock:
                 self._all_workers.append(w)
         return w
 
     def _trace_with(self, w, pixels, spp, film):
+        b = w.buffers
         if self.method == "path":
-            K.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, w.state, w.shadow,
+            K.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
                           film, w.stats)
         else:
             C.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
-                                  (w.state, w.next_state, w.shadow, w.acc, w.root_pixel), film,
+                                  (b.state, b.next_state, b.shadow, b.acc, b.root_pixel), film,
                                   w.stats, self.mode, self.depth, self.branching, self.emit_scale)
 
     def _trace(self, pixels, spp):
@@ -378,9 +433,10 @@ class RenderSession:
 
     def _warm_up(self):
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
-        w = _Worker(max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self.method != "path"
-                    else 64, self.accel, classic=self.method != "path")
-        self._trace_with(w, np.zeros(1, np.int32), 1, Film(1, 1).arrays)
+        classic = self.method != "path"
+        size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if classic else 64
+        self._trace_with(_Worker(_Buffers(size, classic), self.accel), np.zeros(1, np.int32), 1,
+                         Film(1, 1).arrays)
 
     def _update_stats(self, t_start):
         s = self.stats

@@ -96,7 +96,9 @@ class MCEngine(bpy.types.RenderEngine):
         for warning in exported.scene.warnings:
             self.report({"WARNING"}, warning)
         _store_effects(depsgraph.scene.original, exported)
-        self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer")
+        # The first render after installing compiles the numba kernels (cached afterwards).
+        self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "
+                              f"render compiles its kernels, about a minute)")
         render = depsgraph.scene.render
         # Blender's Performance > Threads setting; AUTO leaves the choice to the core.
         threads = render.threads if render.threads_mode == "FIXED" else None

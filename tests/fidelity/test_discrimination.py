@@ -1,0 +1,62 @@
+"""The verdict tells wrong renders from right ones at the CI setting.
+
+Wrong renders are MC Engine renders of a deliberately altered scene compared
+with Cycles on the original; each must give "differ", in the right place and
+direction.  Right renders are Cycles against Cycles with other seeds; every
+scene must give "agree" (this is the false-alarm side of the test, with the
+same alpha as the suite).
+"""
+import bpy
+import numpy as np
+import pytest
+
+from mcengine.report import build_comparison
+
+from .conftest import SCENES, options_for
+
+CI_SCENE = "cornell_box"
+
+
+def _wall_redder(scene):
+    """Red wall: the red channel of its albedo 0.63 -> 0.65."""
+    node = next(n for n in bpy.data.materials["Red"].node_tree.nodes if n.type == "BSDF_DIFFUSE")
+    color = list(node.inputs["Color"].default_value)
+    color[0] += 0.02
+    node.inputs["Color"].default_value = color
+
+
+def test_wall_colour_off_by_two_hundredths_is_caught(renders):
+    result = renders.compare(CI_SCENE, "red wall R +0.02", _wall_redder)
+    a = result.agreement
+    assert result.verdict == "differ"
+    assert a.frame_rejected.tolist() == [True, False, False]
+    differing = a.differing_blocks()
+    assert differing, "the red wall's blocks should differ"
+    # Only red, only brighter, and only in the left quarter of the frame, where
+    # the red wall is (x < 0.25 w at this camera).
+    assert {d["channel"] for d in differing} == {"R"}
+    assert all(d["t"] > 0 for d in differing)
+    assert all(d["col"] < 2 for d in differing), differing
+
+
+def _without_rectangle_light(scene):
+    bpy.data.objects.remove(bpy.data.objects["AreaRectangle"])
+
+
+def test_one_light_missing_is_caught(renders):
+    result = renders.compare("light_area", "without AreaRectangle", _without_rectangle_light)
+    a = result.agreement
+    assert result.verdict == "differ"
+    assert np.all(a.frame_rejected) and np.all(a.frame_rel_bias < 0)
+    assert all(d["t"] < 0 for d in a.differing_blocks()), "a missing light only darkens"
+    assert all(r["ours"] == "darker" for r in result.report["regions"])
+
+
+@pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
+def test_cycles_agrees_with_itself_across_seeds(blend, renders):
+    name = blend.stem
+    options = options_for(name)
+    other = renders.runs(name, "cycles", first_seed=1 + options.seeds)
+    result = build_comparison(f"{name} (Cycles vs Cycles)", other, renders.runs(name, "cycles"),
+                              grid=options.grid, alpha=options.alpha)
+    assert result.verdict == "agree", result.agreement.summary()

@@ -1,9 +1,12 @@
-"""Command line: render a .blend file headless with MC Engine or Cycles, or compare the two.
+"""Command line: render a .blend file headless with MC Engine or Cycles, compare the two,
+or study what accuracy costs in time.
 
 Two spellings take the same options::
 
     mcengine render SCENE.blend [--engine mcengine|cycles] [--samples N] [--resolution WxH]
                                 [--seed S] [--frame F] [-o OUT.exr|OUT.png ...] [-F FORMAT]
+                                [--integrator path|raycast|whitted|distribution]
+                                [--depth R] [--branching B]
     mcengine -b SCENE.blend -E MCENGINE -o /tmp/out_#### -F OPEN_EXR -f 1
 
 The second one is Blender's own background-render syntax (``-b -E -o -f -F -S -t``
@@ -14,6 +17,14 @@ and their long forms), so ``blender -b`` scripts carry over unchanged.
 
     mcengine compare SCENE.blend [--samples N] [--resolution WxH|P%] [--seeds K] [--out DIR]
     mcengine compare --suite FOLDER [same options]      # every .blend in FOLDER, one summary
+
+``study`` renders a ladder of sample counts with each integrator (and Cycles)
+and reports error against time (see ``mcengine_blender.study`` and
+``mcengine.study``)::
+
+    mcengine study SCENE.blend [--out DIR] [--max-samples N] [--integrators path,raycast,...]
+                               [--with-cycles] [--seeds K] [--resolution WxH]
+                               [--depth R] [--branching B] [--target RELMSE]
 
 Conventions
 -----------
@@ -39,8 +50,11 @@ Conventions
   (``bpy.app.handlers.render_stats``), which Cycles reports and which a Python
   engine reports through ``RenderEngine.update_stats``; ``update_progress`` does
   not reach Python handlers in Blender 5.0.
+* After an MC Engine render one line of ray accounting goes to stderr: rays
+  per pixel by kind, Mrays/s and the time of each phase.
 * The only thing written to stdout is the path of each saved image (``compare``:
-  the path of each ``report.json``, or of ``summary.json`` for a suite).
+  the path of each ``report.json``, or of ``summary.json`` for a suite;
+  ``study``: the path of ``study.html``).
 """
 from __future__ import annotations
 
@@ -48,6 +62,7 @@ import argparse
 import contextlib
 import ctypes
 import gzip
+import math
 import os
 import re
 import sys
@@ -91,6 +106,13 @@ MAX_PERCENTAGE = 1000
 DEFAULT_ALPHA = 1e-3
 # The comparison tests an 8x8 grid of blocks, so each side needs 8 pixels.
 MIN_COMPARE_SIZE = 8
+# MC Engine's integrators (scene.mcengine.integrator, lower case) and the
+# ranges of its depth and branching properties (addon/properties.py).
+INTEGRATORS = ("path", "raycast", "whitted", "distribution")
+MAX_DEPTH = 16
+MAX_BRANCHING = 64
+# study: the ladder's largest sample count (25 rungs at most, see mcengine.study).
+MAX_STUDY_SAMPLES = 1 << 24
 
 # A .blend starts with "BLENDER"; Blender 3.0+ may zstd-compress the whole file,
 # older versions gzip it.
@@ -185,6 +207,57 @@ def _engine(text: str) -> str:
     return idname
 
 
+def _integrator(text: str) -> str:
+    name = text.lower()
+    if name not in INTEGRATORS:
+        raise argparse.ArgumentTypeError(
+            f"unknown integrator {text!r} (choose from {', '.join(INTEGRATORS)})")
+    return name
+
+
+def _integrator_list(text: str) -> tuple[str, ...]:
+    names = tuple(_integrator(part.strip()) for part in text.split(",") if part.strip())
+    if not names:
+        raise argparse.ArgumentTypeError("--integrators needs at least one name, e.g. path,raycast")
+    if len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"an integrator is listed twice in {text!r}")
+    return names
+
+
+def _depth(text: str) -> int:
+    return _positive_int(text, "depth", MAX_DEPTH)
+
+
+def _branching(text: str) -> int:
+    return _positive_int(text, "branching", MAX_BRANCHING)
+
+
+def _add_integrator_options(parser, for_study: bool = False) -> None:
+    """--depth and --branching (and --integrator for a render)."""
+    if not for_study:
+        parser.add_argument("--integrator", type=_integrator, default=None,
+                            help="MC Engine's algorithm: path (default), raycast, whitted or "
+                                 "distribution (default: the file's setting)")
+    parser.add_argument("--depth", type=_depth, default=None, metavar="R",
+                        help=f"ray levels of whitted and distribution, 1..{MAX_DEPTH} "
+                             "(the camera ray is level 1)")
+    parser.add_argument("--branching", type=_branching, default=None, metavar="B",
+                        help=f"rays per hit of distribution, 1..{MAX_BRANCHING}")
+
+
+def _check_integrator_options(integrators, depth, branching, engine=None) -> None:
+    """One-line errors for options that the chosen integrators would ignore."""
+    if engine == "CYCLES" and (integrators or depth or branching):
+        raise CliError("--integrator, --depth and --branching choose MC Engine's algorithm; "
+                       "they do not apply to --engine cycles")
+    if not integrators:
+        return
+    if depth is not None and not {"whitted", "distribution"} & set(integrators):
+        raise CliError("--depth applies to the whitted and distribution integrators only")
+    if branching is not None and "distribution" not in integrators:
+        raise CliError("--branching applies to the distribution integrator only")
+
+
 def _format(text: str) -> str:
     name = text.upper()
     if name not in FORMATS:
@@ -226,9 +299,11 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("-S", "--scene", default=None, help="scene to render (default: the file's active scene)")
     render.add_argument("-t", "--threads", type=_threads, default=None,
                         help="CPU threads, 0 = all (default: the file's setting)")
+    _add_integrator_options(render)
     render.add_argument("--verbose", action="store_true",
                         help="show Blender's own log and tracebacks")
     _add_compare_parser(commands)
+    _add_study_parser(commands)
     return parser
 
 
@@ -262,6 +337,58 @@ def _add_compare_parser(commands) -> None:
                          help="CPU threads, 0 = all (default: the file's setting)")
     compare.add_argument("--verbose", action="store_true",
                          help="show Blender's own log and tracebacks")
+
+
+def _add_study_parser(commands) -> None:
+    from mcengine.study import DEFAULT_MAX_SAMPLES, DEFAULT_SEEDS, DEFAULT_TARGET_RELMSE
+
+    study = commands.add_parser(
+        "study", help="measure what accuracy costs in time, per integrator and for Cycles",
+        description="Render the scene at 1, 2, 4, ... N samples per pixel with each integrator "
+                    "(and Cycles), several seeds each, time every render and measure its error "
+                    "against a converged reference. Writes study.csv, error_vs_time.png, "
+                    "error_vs_samples.png, equal_time.png, study.html, study.md and study.json.")
+    study.add_argument("blendfile", metavar="SCENE.blend", help="the file to study")
+    study.add_argument("--out", metavar="DIR", default=None,
+                       help="output folder, created if missing (default: ./study-SCENE)")
+    study.add_argument("--max-samples", type=_study_samples, default=DEFAULT_MAX_SAMPLES,
+                       metavar="N", help=f"largest sample count of the ladder "
+                                         f"(default {DEFAULT_MAX_SAMPLES})")
+    study.add_argument("--integrators", type=_integrator_list, default=INTEGRATORS,
+                       metavar="LIST", help="comma-separated, from " + ",".join(INTEGRATORS)
+                                            + " (default: all)")
+    study.add_argument("--with-cycles", action="store_true",
+                       help="also study Cycles, against its own reference")
+    study.add_argument("--seeds", type=_seeds, default=DEFAULT_SEEDS, metavar="K",
+                       help=f"renders per sample count, 2..{MAX_SEEDS} (default {DEFAULT_SEEDS})")
+    study.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
+                       help="image size in pixels (default: the file's size and percentage)")
+    study.add_argument("--target", type=_target, default=DEFAULT_TARGET_RELMSE,
+                       metavar="RELMSE", help=f"relMSE whose time to reach is reported "
+                                              f"(default {DEFAULT_TARGET_RELMSE:g})")
+    study.add_argument("--reference-samples", type=_samples, default=None, metavar="M",
+                       help="samples per pixel of each reference (default: 16 x N)")
+    _add_integrator_options(study, for_study=True)
+    study.add_argument("-S", "--scene", default=None,
+                       help="scene to study (default: the file's active scene)")
+    study.add_argument("-t", "--threads", type=_threads, default=None,
+                       help="CPU threads, 0 = all (default: the file's setting)")
+    study.add_argument("--verbose", action="store_true",
+                       help="show Blender's own log and tracebacks")
+
+
+def _study_samples(text: str) -> int:
+    return _positive_int(text, "largest sample count", MAX_STUDY_SAMPLES)
+
+
+def _target(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"target must be a number, got {text!r}") from None
+    if not 0.0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f"target relMSE must be positive, got {value:g}")
+    return value
 
 
 def _compare_resolution(text: str):
@@ -338,6 +465,9 @@ class RenderRequest:
     scene: str | None
     threads: int | None
     verbose: bool
+    integrator: str | None = None
+    depth: int | None = None
+    branching: int | None = None
 
 
 def check_blend_file(path: Path) -> None:
@@ -477,7 +607,47 @@ def _compare_request(args) -> CompareRequest:
         scene=args.scene, threads=args.threads, verbose=args.verbose)
 
 
-def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | None:
+@dataclass(frozen=True)
+class StudyRequest:
+    """A validated ``study`` command line."""
+
+    blendfile: Path
+    out: Path
+    max_samples: int
+    integrators: tuple
+    with_cycles: bool
+    seeds: int
+    resolution: tuple[int, int] | None
+    target: float
+    reference_samples: int | None
+    depth: int | None
+    branching: int | None
+    scene: str | None
+    threads: int | None
+    verbose: bool
+
+
+def _study_request(args) -> StudyRequest:
+    from mcengine.study import REFERENCE_RENDERS
+    blendfile = Path(args.blendfile).absolute()
+    check_blend_file(blendfile)
+    _check_integrator_options(args.integrators, args.depth, args.branching)
+    if args.reference_samples is not None and args.reference_samples < max(
+            2 * args.max_samples, REFERENCE_RENDERS):
+        raise CliError(f"--reference-samples {args.reference_samples} is too few to measure "
+                       f"errors against: use at least {max(2 * args.max_samples, REFERENCE_RENDERS)} "
+                       f"(twice --max-samples), ideally 16 times")
+    out = Path(args.out if args.out is not None else f"study-{blendfile.stem}").absolute()
+    prepare_output_folder(out)
+    return StudyRequest(
+        blendfile=blendfile, out=out, max_samples=args.max_samples,
+        integrators=args.integrators, with_cycles=args.with_cycles, seeds=args.seeds,
+        resolution=args.resolution, target=args.target,
+        reference_samples=args.reference_samples, depth=args.depth, branching=args.branching,
+        scene=args.scene, threads=args.threads, verbose=args.verbose)
+
+
+def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest | None:
     """Validate the command line; None means help/version was printed."""
     if any(arg in ("-b", "--background") for arg in argv):
         argv = _blender_style(argv)
@@ -492,6 +662,11 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | None:
         return None
     if args.command == "compare":
         return _compare_request(args)
+    if args.command == "study":
+        return _study_request(args)
+    engine = args.engine or DEFAULT_ENGINE
+    _check_integrator_options((args.integrator,) if args.integrator else (), args.depth,
+                              args.branching, engine)
     blendfile = Path(args.blendfile).absolute()
     check_blend_file(blendfile)
     raw_outputs = args.outputs or [f"{blendfile.stem}{FORMATS[args.format or DEFAULT_FORMAT]}"]
@@ -499,9 +674,10 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | None:
     for output in outputs:
         check_output_folder(output.pattern)
     return RenderRequest(
-        blendfile=blendfile, engine=args.engine or DEFAULT_ENGINE, outputs=outputs,
+        blendfile=blendfile, engine=engine, outputs=outputs,
         samples=args.samples, resolution=args.resolution, seed=args.seed, frame=args.frame,
-        scene=args.scene, threads=args.threads, verbose=args.verbose)
+        scene=args.scene, threads=args.threads, verbose=args.verbose,
+        integrator=args.integrator, depth=args.depth, branching=args.branching)
 
 
 def frame_path(pattern: Path, frame: int) -> Path:
@@ -699,6 +875,14 @@ def _apply_overrides(scene, request: RenderRequest) -> None:
             scene.render.threads = request.threads
     if request.frame is not None:
         scene.frame_set(request.frame)
+    own = getattr(scene, "mcengine", None)
+    if own is not None:
+        if request.integrator is not None:
+            own.integrator = request.integrator.upper()
+        if request.depth is not None:
+            own.depth = request.depth
+        if request.branching is not None:
+            own.branching = request.branching
 
 
 def _set_image_format(scene, file_format: str) -> None:
@@ -772,9 +956,19 @@ def run(request: RenderRequest) -> int:
         f"{PROG}: rendered {scene.name!r} frame {frame} with {request.engine}, "
         f"{round(render.resolution_x * scale)}x{round(render.resolution_y * scale)}, "
         f"{scene.cycles.samples} samples, in {time.monotonic() - started:.1f} s\n")
+    if request.engine == "MCENGINE":
+        accounting = _ray_accounting()
+        if accounting:
+            log.console.write(f"{PROG}: {accounting}\n")
     for path in paths:
         print(path)
     return EXIT_OK
+
+
+def _ray_accounting() -> str | None:
+    """The last MC Engine render's ray accounting line (None if the engine kept none)."""
+    from .engine import last_render
+    return last_render.get("accounting")
 
 
 def _import_bpy_with_addon():
@@ -797,10 +991,11 @@ Called while Blender's log is captured (the whole comparison runs inside
     the comparison reports as a failed render.
     """
 
-    def __init__(self, bpy, log: BlenderLog, threads: int | None):
+    def __init__(self, bpy, log: BlenderLog, threads: int | None, bars: bool = True):
         self.bpy = bpy
         self.log = log
         self.threads = threads
+        self.bars = bars           # False: no progress display per render
         self.label = ""
         self.warnings: list[str] = []
 
@@ -815,12 +1010,14 @@ Called while Blender's log is captured (the whole comparison runs inside
                 scene.render.threads = self.threads
         progress = Progress(self.log.console, self.label or engine)
         start = self.log.mark()
-        self.bpy.app.handlers.render_stats.append(progress.on_stats)
+        if self.bars:
+            self.bpy.app.handlers.render_stats.append(progress.on_stats)
         try:
             result = render_scene(scene, engine, **settings)
         finally:
-            self.bpy.app.handlers.render_stats.remove(progress.on_stats)
-            progress.finish()
+            if self.bars:
+                self.bpy.app.handlers.render_stats.remove(progress.on_stats)
+                progress.finish()
         text = self.log.text(since=start)
         crash = engine_traceback(text)
         if crash is not None:
@@ -884,6 +1081,60 @@ def run_compare(request: CompareRequest) -> int:
     return EXIT_OK if comparison.verdict == "agree" else EXIT_DIFFER
 
 
+def run_study(request: StudyRequest) -> int:
+    """Render the study and write its files; returns the exit status."""
+    log = BlenderLog(passthrough=request.verbose)
+    with log.capture():
+        bpy = _import_bpy_with_addon()
+    from mcengine.study import StudyError, StudyOptions, summarise, write_study
+
+    from .study import StudySettings, study_file
+    console = log.console
+    # One line per render: a study makes a hundred, too many for a bar each.
+    renderer = _CompareRenderer(bpy, log, None, bars=False)
+
+    def on_render(label, index, total):
+        renderer.label = label
+        console.write(f"{PROG}: [{index + 1}/{total}] {label}\n")
+
+    options = StudyOptions(integrators=request.integrators, with_cycles=request.with_cycles,
+                           max_samples=request.max_samples, seeds=request.seeds,
+                           reference_samples=request.reference_samples,
+                           target_relmse=request.target)
+    settings = StudySettings(resolution=request.resolution, depth=request.depth,
+                             branching=request.branching, threads=request.threads)
+    try:
+        with log.capture():
+            study = study_file(request.blendfile, options, settings, scene_name=request.scene,
+                               render=renderer, on_render=on_render)
+            paths = write_study(study, request.out)
+    except (StudyError, RuntimeError) as exc:
+        raise CliError(str(exc).splitlines()[0], EXIT_RENDER_FAILED) from None
+    for warning in renderer.warnings:
+        console.write(f"{PROG}: warning: {warning}\n")
+    for name, s in summarise(study).items():
+        console.write(f"{PROG}: {study_line(name, s)}\n")
+    console.write(f"{PROG}: wrote {paths['csv']}, {paths['time']}, {paths['markdown']}\n")
+    print(paths["html"])
+    return EXIT_OK
+
+
+def study_line(name: str, s) -> str:
+    """One line per integrator: time to target, slope, plateau."""
+    if s.time_to_target is None:
+        reach = f"does not reach relMSE {s.target:g}"
+    else:
+        how = {"extrapolated": " (extrapolated)", "first rung": " (at 1 sample)"}.get(
+            s.target_how, "")
+        reach = f"relMSE {s.target:g} in {s.time_to_target:.2f} s{how}"
+    parts = [f"{name}: {reach}"]
+    if s.slope is not None:
+        parts.append(f"slope {s.slope:.3f} ± {s.slope_ci:.3f}")
+    if s.plateau:
+        parts.append(f"plateau at relMSE {s.floor:.3g}")
+    return ", ".join(parts)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Console entry point; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
@@ -894,6 +1145,8 @@ def main(argv: list[str] | None = None) -> int:
             return EXIT_OK
         if isinstance(request, CompareRequest):
             return run_compare(request)
+        if isinstance(request, StudyRequest):
+            return run_study(request)
         return run(request)
     except CliError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)

@@ -30,7 +30,8 @@ _REPLACED_BY_CYCLES = {
 
 
 class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
-    """Render Properties > MC Engine: what the last render used and ignored."""
+    """Render Properties > MC Engine: the integrator, the tools, and what the last render
+    used, ignored and cost in rays and time."""
 
     bl_label = "MC Engine"
     bl_space_type = "PROPERTIES"
@@ -44,14 +45,37 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
 
     def draw(self, context):
         settings = context.scene.mcengine
-        self.layout.operator("mcengine.compare_with_cycles", icon="SEQ_SPLITVIEW")
-        col = self.layout.column(align=True)
+        layout = self.layout
+        _draw_integrator(layout, settings)
+        row = layout.row(align=True)
+        row.operator("mcengine.compare_with_cycles", icon="SEQ_SPLITVIEW")
+        row.operator("mcengine.study_accuracy", icon="GRAPH")
+        col = layout.column(align=True)
         if not settings.last_effects:
             col.label(text="Not rendered yet", icon="INFO")
             return
         col.label(text=f"Effects: {settings.last_effects}", icon="SHADING_RENDERED")
         if settings.last_ignored:
             col.label(text=f"Ignored: {settings.last_ignored}", icon="ERROR")
+        accounting = settings.get("last_accounting")
+        if accounting:
+            # One label per part: the whole line is wider than the panel.
+            for part in accounting.split(" | "):
+                col.label(text=part)
+
+
+def _draw_integrator(layout, settings) -> None:
+    """The integrator and, where they apply, its depth and branching."""
+    col = layout.column()
+    col.use_property_split = True
+    col.use_property_decorate = False
+    col.prop(settings, "integrator")
+    if settings.integrator in ("WHITTED", "DISTRIBUTION"):
+        col.prop(settings, "depth")
+    if settings.integrator == "DISTRIBUTION":
+        col.prop(settings, "branching")
+        rays = sum(settings.branching ** k for k in range(settings.depth))
+        col.label(text=f"Up to {rays:,} rays per sample (1 + b + ... + b^(depth-1))")
 
 
 def compatible_panels() -> list:

@@ -130,4 +130,4 @@ def test_button_is_in_the_mc_engine_render_panel(addon, scene):
     from .test_render_loop import _panel_text
     operators = []
     _panel_text(addon, scene, operators)
-    assert operators == ["mcengine.compare_with_cycles"]
+    assert operators == ["mcengine.compare_with_cycles", "mcengine.study_accuracy"]

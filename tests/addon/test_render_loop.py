@@ -90,14 +90,17 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
                                          "Ignored: specular, denoising"]
 
 
-def _panel_text(addon, scene, operators=None):
+def _panel_text(addon, scene, operators=None, props=None):
     """The labels the MC Engine render panel draws (with a recording stand-in layout);
-    the operator buttons' ids go to ``operators`` if given."""
+    the operator buttons' ids go to ``operators`` and the property names to ``props``
+    if given."""
     lines = []
 
     class Layout:
         def column(self, **_):
             return self
+
+        row = column
 
         def label(self, text="", **_):
             lines.append(text)
@@ -105,6 +108,10 @@ def _panel_text(addon, scene, operators=None):
         def operator(self, idname, **_):
             if operators is not None:
                 operators.append(idname)
+
+        def prop(self, data, name, **_):
+            if props is not None:
+                props.append(name)
 
     panel = SimpleNamespace(layout=Layout())
     addon.ui.MCENGINE_RENDER_PT_engine.draw(panel, SimpleNamespace(scene=scene))

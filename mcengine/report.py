@@ -377,7 +377,7 @@ def report_markdown(c: Comparison) -> str:
             f"| {_num(mc['mean'], '.5f')} [{_num(mc['ci'][0], '.5f')}, {_num(mc['ci'][1], '.5f')}] "
             f"| {_pct(r['frame']['rel_bias'][ch])} [{_pct(lo)}, {_pct(hi)}] "
             f"| {_num(r['frame']['t'][ch], '+.2f')} | {_num(r['frame']['p_holm'][ch], '.3g')} "
-            f"| {_num(_scaled(r['frame']['detectable_bias'][ch]), '.1f')} % |")
+            f"| {_num(_scaled(r['frame']['detectable_bias'][ch]), '.2g')} % |")
     m, b = r["metrics"], r["blocks"]
     gy, gx = r["test"]["grid"]
     lines += ["", "## Image metrics", "",
@@ -642,7 +642,7 @@ def _cells(row: SuiteRow) -> list:
         return [row.scene, "**error**", row.error] + [""] * (len(_COLUMNS) - 3)
     return [row.scene, row.verdict if row.verdict == "agree" else f"**{row.verdict}**",
             f"{100 * row.max_abs_bias:.2f} %" if row.max_abs_bias is not None else "",
-            f"{100 * row.detectable_bias:.1f} %" if row.detectable_bias is not None else "",
+            f"{100 * row.detectable_bias:.2g} %" if row.detectable_bias is not None else "",
             row.blocks_differ, _num(row.relmse, ".3g"), _num(row.flip, ".3f"),
             _num(row.seconds_ours, ".2f"), _num(row.seconds_cycles, ".2f"), _ratio(row)]
 

@@ -127,6 +127,7 @@ def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySe
     batch.ensure_registered()
     own = scene.mcengine
     saved = {key: getattr(own, key) for key in _OWN_SETTINGS}
+    threads = scene.render.threads_mode, scene.render.threads
     chosen = _integrator_settings(scene, settings)
     try:
         with batch.restoring(scene):
@@ -149,13 +150,20 @@ def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySe
                 except RuntimeError as exc:
                     raise StudyError(f"{integrator} render failed: {error_message(exc)}") from None
 
-            return run_study(render_one, options, scene=name or scene.name,
-                             settings=_descriptions(chosen, options.integrators),
-                             notes=[TIMING_NOTE], on_render=on_render)
+            study = run_study(render_one, options, scene=name or scene.name,
+                              settings=_descriptions(chosen, options.integrators),
+                              notes=[TIMING_NOTE], on_render=on_render)
     finally:
         for key, value in saved.items():
             if getattr(own, key) != value:
                 setattr(own, key, value)
+        if (scene.render.threads_mode, scene.render.threads) != threads:
+            scene.render.threads_mode, scene.render.threads = threads
+    if options.integrators and own.last_ignored:
+        study.notes.append(f"MC Engine does not support, and rendered without: "
+                           f"{own.last_ignored}. Its reference leaves them out too, so its "
+                           f"errors measure its own convergence, not its agreement with Cycles.")
+    return study
 
 
 def study_file(path, options: StudyOptions = StudyOptions(),

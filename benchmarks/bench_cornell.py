@@ -91,7 +91,8 @@ def main(argv=None) -> int:
           f"{med['MCENGINE']['marginal'] / med['CYCLES']['marginal']:20.2f}")
     print(f"MC Engine: {st.rays / st.paths:.2f} rays/path, {st.rays_per_second / 1e6:.1f} Mrays/s, "
           f"Embree {100 * st.embree_share:.0f} % of worker time, kernels loaded in "
-          f"{st.time_kernels:.2f} s, BVH {st.time_bvh * 1e3:.0f} ms")
+          f"{sessions[0].stats.time_kernels:.2f} s (first render of the process), "
+          f"BVH {st.time_bvh * 1e3:.0f} ms")
     print(f"memory: renderer buffers {buffers / 2**20:.0f} MiB; process peak RSS "
           f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB (Blender included)")
     return 0

@@ -37,7 +37,19 @@ STUDY_FOLDER = "mcengine_study"
 _UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
 
 
-class MCENGINE_OT_compare_with_cycles(bpy.types.Operator):
+class _RendersScene:
+    """Mixin of the operators that render the open scene: they need an active camera."""
+
+    @classmethod
+    def poll(cls, context):
+        scene = context.scene
+        if scene is None or scene.camera is None:
+            cls.poll_message_set("The scene needs an active camera")
+            return False
+        return True
+
+
+class MCENGINE_OT_compare_with_cycles(_RendersScene, bpy.types.Operator):
     """Render this scene with MC Engine and with Cycles and show where they differ"""
 
     bl_idname = "mcengine.compare_with_cycles"
@@ -58,13 +70,6 @@ class MCENGINE_OT_compare_with_cycles(bpy.types.Operator):
         description="Where the report and images go; empty: a folder in the temporary "
                     "directory, named after the scene")
 
-    @classmethod
-    def poll(cls, context):
-        scene = context.scene
-        if scene is None or scene.camera is None:
-            cls.poll_message_set("The scene needs an active camera")
-            return False
-        return True
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self, confirm_text="Compare")
@@ -108,7 +113,7 @@ def _output_folder(directory: str, default_folder: str, scene) -> Path:
     return Path(tempfile.gettempdir()) / default_folder / name
 
 
-class MCENGINE_OT_study_accuracy(bpy.types.Operator):
+class MCENGINE_OT_study_accuracy(_RendersScene, bpy.types.Operator):
     """Render this scene with every integrator at 1, 2, 4, ... samples and plot error against time"""
 
     bl_idname = "mcengine.study_accuracy"
@@ -132,13 +137,6 @@ class MCENGINE_OT_study_accuracy(bpy.types.Operator):
         description="Where the report and plots go; empty: a folder in the temporary "
                     "directory, named after the scene")
 
-    @classmethod
-    def poll(cls, context):
-        scene = context.scene
-        if scene is None or scene.camera is None:
-            cls.poll_message_set("The scene needs an active camera")
-            return False
-        return True
 
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self, confirm_text="Study")

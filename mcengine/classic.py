@@ -38,7 +38,7 @@ from .bsdf import (LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT, M_EMISSION, M_
 from .integrator import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD,
                          CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
                          PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS,
-                         ST_SHADOW_RAYS, clamp_light, emission_weight, generate_camera_rays,
+                         ST_SHADOW_RAYS, add_light, clamp_light, emission_weight, generate_camera_rays,
                          hit_distance, lamps_on_segment, local_frame, next_path_flags,
                          past_self_hit, power_heuristic, push_shadow, sample_light, set_ray,
                          sun_light, surface_geometry)
@@ -70,15 +70,6 @@ def widest_generation(method: str, depth: int, branching: int) -> int:
         return 1
     b = 2 if method == "whitted" else branching
     return b ** (depth - 1)
-
-
-@device
-def _accumulate(acc, root, r, g, b, direct, fcfg, stats):
-    limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
-    r, g, b = clamp_light(r, g, b, limit, stats)
-    acc[root, 0] += r
-    acc[root, 1] += g
-    acc[root, 2] += b
 
 
 @device
@@ -153,19 +144,19 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
                 st.mis_pdf[i], True, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
-                _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
+                add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
                 if st.transparent[i] + passed >= cfg[CFG_MAX_TRANSPARENT]:
                     continue
         if p < 0:
             if flags & PF_TRANSPARENT_BG:
                 acc[root, 3] = 1.0
             elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
-                _accumulate(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
+                add_light(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
                             arrival_direct, fcfg, stats)
             if n_lamps:
                 lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], True)
                 if lr + lg + lb > 0.0:
-                    _accumulate(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
+                    add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
             continue
         if sc.tri_area[p] <= 0.0:
             continue
@@ -175,7 +166,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
         if sc.materials[m, M_EMISSIVE] > 0.0:
             w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
                                 st.mis_pdf[i], emit_scale)
-            _accumulate(acc, root, br * sc.materials[m, M_EMISSION] * w,
+            add_light(acc, root, br * sc.materials[m, M_EMISSION] * w,
                         bg * sc.materials[m, M_EMISSION + 1] * w,
                         bb * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
         if not bsdf_has_lobes(sc.materials, m):

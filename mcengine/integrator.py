@@ -220,7 +220,8 @@ def clamp_light(r, g, b, limit, stats):
 
 
 @device
-def _add(radiance, i, r, g, b, direct, fcfg, stats):
+def add_light(radiance, i, r, g, b, direct, fcfg, stats):
+    """Add a clamped contribution to row i of ``radiance`` (direct or indirect limit)."""
     limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
     r, g, b = clamp_light(r, g, b, limit, stats)
     radiance[i, 0] += r
@@ -536,7 +537,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                 sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
                 st.mis_pdf[i], False, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
-                _add(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
+                add_light(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                      arrival_direct, fcfg, stats)
                 st.transparent[i] += passed
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
@@ -547,12 +548,12 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
             if flags & PF_TRANSPARENT_BG:
                 st.transparency[i] = 1.0
             elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
-                _add(st.radiance, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
+                add_light(st.radiance, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
                      st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
             if n_lamps:
                 lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], False)
                 if lr + lg + lb > 0.0:
-                    _add(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
+                    add_light(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                          arrival_direct, fcfg, stats)
             continue
 
@@ -573,7 +574,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         if sc.materials[m, M_EMISSIVE] > 0.0:
             w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
                                 st.mis_pdf[i], 1.0)
-            _add(st.radiance, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
+            add_light(st.radiance, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
                  st.beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
                  st.beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
 

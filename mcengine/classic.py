@@ -37,6 +37,7 @@ from .bsdf import (LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT, M_EMISSION, M_
                    bsdf_has_lobes, bsdf_sample, fresnel_dielectric)
 from .integrator import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD,
                          CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
+                         PMF_EVERY,
                          PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS,
                          ST_SHADOW_RAYS, add_light, clamp_light, emission_weight, generate_camera_rays,
                          hit_distance, lamps_on_segment, local_frame, next_path_flags,
@@ -141,8 +142,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
 
         if lamps_hit:
             lr, lg, lb, passed = lamps_on_segment(
-                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
-                st.mis_pdf[i], True, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, st.mis_pdf[i], PMF_EVERY,
+                0.0, 0.0, 0.0, 0.0, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
                 add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
                 if st.transparent[i] + passed >= cfg[CFG_MAX_TRANSPARENT]:
@@ -154,7 +155,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 add_light(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
                             arrival_direct, fcfg, stats)
             if n_lamps:
-                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], True)
+                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], PMF_EVERY,
+                                       0.0, 0.0, 0.0, 0.0)
                 if lr + lg + lb > 0.0:
                     add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
             continue

@@ -36,11 +36,12 @@ from .bsdf import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, L
 from .camera import camera_ray
 from .intersect import SHADOW_SHORTEN, T_INFINITE, intersect_prim, offset_origin, offset_scale
 from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW,
+                     group_importance, lamp_importance,
                      LF_USE_MIS, LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY,
                      LF_VIS_TRANSMISSION, LT_SUN, intersect_lamp, pick_light, sample_lamp,
                      sample_triangle_point, sun_radiance)
 from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_FILTER_X, DIM_FILTER_Y,
-                       DIM_LIGHT_PICK, DIM_LIGHT_U, DIM_LIGHT_V, DIM_ROULETTE, bounce_dim,
+                       DIM_LIGHT_GROUP, DIM_LIGHT_PICK, DIM_LIGHT_U, DIM_LIGHT_V, DIM_ROULETTE, bounce_dim,
                        filter_offset, orthonormal_basis, path_key, power_heuristic, rand)
 
 # -- path state ----------------------------------------------------------------------
@@ -61,6 +62,7 @@ PathState = namedtuple("PathState", [
     "transparent",   # (B,) int32    transparent passes (lamps count as one)
     "flags",         # (B,) int32    PF_* bits
     "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
+    "mis_p",         # (B, 3) f64    the vertex that ray left (light picking there, for MIS)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
     "alive",         # (B,) uint8    still tracing after this bounce
     "o32",           # (B, 3) f32    Embree input: origins
@@ -85,6 +87,7 @@ SceneData = namedtuple("SceneData", [
     "emit_tri",      # (NE,) int32  emissive triangle ids
     "emit_pmf",      # (NE,) f64    their NEE probabilities
     "emit_cdf",      # (NE + 1,) f64  distribution over emissive triangles alone
+    "emit_group",    # (5,) f64     emissive triangles as one light: centre, radius^2, scale
     "tri_light",     # (T,) int32   index into emit_tri, or -1
     "tri_area",      # (T,) f64
     "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
@@ -120,11 +123,18 @@ CFG_REGION_W = 12
 CFG_FULL_W = 13
 CFG_LIGHTS = 14           # NEE has something to sample
 CFG_WORLD = 15            # the world is not black
-CFG_SIZE = 16
+CFG_LOCAL_LIGHTS = 16     # pick lights by their estimated irradiance at each point
+CFG_SIZE = 17
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1
-FCFG_SIZE = 2
+FCFG_EMIT_SCALE = 2       # 1 / (share of the emissive triangles in the scene-wide pmf)
+FCFG_SIZE = 3
+
+# How a light's selection probability is known, for MIS weights.
+PMF_GLOBAL = 0            # by power, scene-wide (lamps[:, L_PMF], emit_pmf)
+PMF_EVERY = 1             # every light is sampled (classic integrators)
+PMF_LOCAL = 2             # by estimated irradiance at the vertex the ray left
 
 # Statistics counters (stats array, per worker).
 ST_CAMERA_RAYS = 0
@@ -144,7 +154,8 @@ def alloc_path_state(n: int) -> PathState:
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
-        mis_pdf=np.zeros(n), self_prim=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
+        mis_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
+        alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
 
@@ -328,14 +339,62 @@ def surface_geometry(verts, tris, tri_normal, normals, p, b1, b2, dx, dy, dz):
 
 
 @device
-def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every_light,
-                     transparent_left):
+def local_light_total(lamps, group, has_group, px, py, pz):
+    """Sum of every light's importance at p (lamps, and the emissive triangles as one)."""
+    total = 0.0
+    for li in range(lamps.shape[0]):
+        total += lamp_importance(lamps, li, px, py, pz)
+    if has_group:
+        total += group_importance(group, px, py, pz)
+    return total
+
+
+@device
+def lamp_pick_pmf(lamps, li, pmf_mode, px, py, pz, total):
+    """Probability that next-event estimation at p picks lamp li."""
+    if pmf_mode == PMF_EVERY:
+        return 1.0
+    if pmf_mode == PMF_LOCAL:
+        return lamp_importance(lamps, li, px, py, pz) / total if total > 0.0 else 0.0
+    return lamps[li, L_PMF]
+
+
+@device
+def pick_light_local(lamps, group, has_group, px, py, pz, u):
+    """Pick a light at p in proportion to its importance there.
+
+    Returns ``(choice, pmf)``: a lamp index, or ``n_lamps`` for the emissive
+    triangles as a group; ``pmf`` 0 if nothing can light p.
+    """
+    n_lamps = lamps.shape[0]
+    total = local_light_total(lamps, group, has_group, px, py, pz)
+    if total <= 0.0:
+        return 0, 0.0
+    target = u * total
+    acc = 0.0
+    last = -1
+    last_w = 0.0
+    for li in range(n_lamps):
+        w = lamp_importance(lamps, li, px, py, pz)
+        if w > 0.0:
+            acc += w
+            last, last_w = li, w
+            if target < acc:
+                return li, w / total
+    if has_group:
+        return n_lamps, group_importance(group, px, py, pz) / total
+    return last, last_w / total      # rounding at the end of the scan
+
+
+@device
+def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+                     mpx, mpy, mpz, mis_total, transparent_left):
     """Light from lamps the ray passes through before t_hit (lamps do not block rays).
 
     Lamps are visited nearest first; each one counts as a transparent bounce
     (Cycles), at most ``transparent_left`` of them.  MIS weights use the NEE
-    pdf of the lamp: its selection probability times the solid-angle pdf, or
-    the solid-angle pdf alone when every light is sampled (``every_light``).
+    pdf of the lamp: its selection probability (see :func:`lamp_pick_pmf`)
+    times the solid-angle pdf.
     Returns ``(r, g, b, lamps_passed)``, unweighted by the path throughput.
     """
     lr_sum = lg_sum = lb_sum = 0.0
@@ -361,7 +420,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every
             break
         w = 1.0
         if not (flags & PF_MIS_SKIP):
-            pmf = 1.0 if every_light else lamps[best, L_PMF]
+            pmf = lamp_pick_pmf(lamps, best, pmf_mode, mpx, mpy, mpz, mis_total)
             w = power_heuristic(mis_pdf, pmf * bpdf)
         lr_sum += br * w
         lg_sum += bg * w
@@ -373,7 +432,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, every
 
 
 @device
-def sun_light(lamps, dx, dy, dz, flags, mis_pdf, every_light):
+def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total):
     """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
     r = g = b = 0.0
     for li in range(lamps.shape[0]):
@@ -386,7 +445,7 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, every_light):
         if lpdf > 0.0:
             w = 1.0
             if not (flags & PF_MIS_SKIP):
-                pmf = 1.0 if every_light else lamps[li, L_PMF]
+                pmf = lamp_pick_pmf(lamps, li, pmf_mode, mpx, mpy, mpz, mis_total)
                 w = power_heuristic(mis_pdf, pmf * lpdf)
             r += lr * w
             g += lg * w
@@ -515,6 +574,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
     n_shadow = 0
     n_lamps = sc.lamps.shape[0]
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    local = cfg[CFG_LOCAL_LIGHTS] != 0
+    pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
+    has_group = sc.emit_tri.shape[0] > 0
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
@@ -530,12 +592,17 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         flags = st.flags[i]
         t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
         arrival_direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
+        # Light-picking probabilities at the vertex this ray left, for MIS.
+        mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
+        mis_total = 0.0
+        if local and not (flags & PF_MIS_SKIP):
+            mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, mpx, mpy, mpz)
 
         # -- lamps along the ray ---------------------------------------------------------
         if lamps_hit:
             lr, lg, lb, passed = lamps_on_segment(
-                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags,
-                st.mis_pdf[i], False, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, st.mis_pdf[i], pmf_mode,
+                mpx, mpy, mpz, mis_total, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
                 add_light(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                      arrival_direct, fcfg, stats)
@@ -551,7 +618,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                 add_light(st.radiance, i, st.beta[i, 0] * sc.world[0], st.beta[i, 1] * sc.world[1],
                      st.beta[i, 2] * sc.world[2], arrival_direct, fcfg, stats)
             if n_lamps:
-                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], False)
+                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], pmf_mode,
+                                       mpx, mpy, mpz, mis_total)
                 if lr + lg + lb > 0.0:
                     add_light(st.radiance, i, st.beta[i, 0] * lr, st.beta[i, 1] * lg, st.beta[i, 2] * lb,
                          arrival_direct, fcfg, stats)
@@ -572,8 +640,12 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # Emission (two-sided).
         if sc.materials[m, M_EMISSIVE] > 0.0:
+            group_share = 1.0
+            if local and mis_total > 0.0:
+                group_share = (group_importance(sc.emit_group, mpx, mpy, mpz) / mis_total
+                               * fcfg[FCFG_EMIT_SCALE])
             w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
-                                st.mis_pdf[i], 1.0)
+                                st.mis_pdf[i], group_share)
             add_light(st.radiance, i, st.beta[i, 0] * sc.materials[m, M_EMISSION] * w,
                  st.beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
                  st.beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
@@ -592,15 +664,23 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
 
         # -- next-event estimation: one light, picked by power ---------------------------------
         if cfg[CFG_LIGHTS]:
-            idx = pick_light(sc.light_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_PICK)))
-            pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
+            u_pick = rand(key, bounce_dim(bounce, DIM_LIGHT_PICK))
+            if local:
+                idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, hx, hy, hz, u_pick)
+                if idx == n_lamps:
+                    j = pick_light(sc.emit_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_GROUP)))
+                    idx = n_lamps + j
+                    pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+            else:
+                idx = pick_light(sc.light_cdf, u_pick)
+                pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
             (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
              lnx, lny, lnz) = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal,
                                            sc.tri_area, sc.mat_index, sc.materials, idx, pmf,
                                            hx, hy, hz, bounce,
                                            rand(key, bounce_dim(bounce, DIM_LIGHT_U)),
                                            rand(key, bounce_dim(bounce, DIM_LIGHT_V)))
-            if lr + lg + lb > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
+            if pmf > 0.0 and lr + lg + lb > 0.0 and wix * ngx + wiy * ngy + wiz * ngz > 0.0:
                 fr, fg, fb, bsdf_pdf = bsdf_eval(
                     sc.materials, m, wox, woy, woz, wix * tx + wiy * ty + wiz * tz,
                     wix * bx + wiy * by + wiz * bz, wix * nsx + wiy * nsy + wiz * nsz, exclude)
@@ -657,6 +737,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                 new_flags |= PF_TERMINATE
         st.flags[i] = new_flags
         st.mis_pdf[i] = pdf
+        st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = hx, hy, hz
         nox, noy, noz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
         set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
                 nox, noy, noz, wix, wiy, wiz, math.inf)
@@ -714,6 +795,7 @@ def _move(st, i, m):
         st.radiance[m, c] = st.radiance[i, c]
         st.o32[m, c] = st.o32[i, c]
         st.d32[m, c] = st.d32[i, c]
+        st.mis_p[m, c] = st.mis_p[i, c]
     st.ray_tmax[m] = st.ray_tmax[i]
     st.transparency[m] = st.transparency[i]
     st.bounce[m] = st.bounce[i]

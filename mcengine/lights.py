@@ -66,8 +66,14 @@ L_SPREAD_TAN = 34    # tan(spread / 2); negative: no spread attenuation
 L_SPREAD_NORM = 35   # 1 / (tan(spread/2) - spread/2)
 L_FLAGS = 36
 L_MAX_BOUNCES = 37
-L_PMF = 38           # probability of picking this lamp for NEE
-LIGHT_STRIDE = 39
+L_PMF = 38           # probability of picking this lamp for NEE (by power, scene-wide)
+L_IMPORTANCE = 39    # scale of the irradiance estimate that picks lights per shading point
+LIGHT_STRIDE = 40
+
+# Per-point light selection never gives a light less than this share of its
+# unattenuated weight where it might still contribute (spot edges with a
+# radius, area lights seen edge-on): any non-zero probability is unbiased.
+IMPORTANCE_FLOOR = 0.02
 
 # L_FLAGS bits.
 LF_CAST_SHADOW = 1
@@ -128,6 +134,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
             else:
                 row[L_RADIANCE:L_RADIANCE + 3] = strength / (4.0 * math.pi)
             power[i] = strength.mean()
+            row[L_IMPORTANCE] = strength.mean() / (4.0 * math.pi)
             if li.type == "SPOT":
                 c = math.cos(0.5 * float(li.spot_size))
                 row[L_SPOT_COS] = c
@@ -146,6 +153,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
             else:
                 row[L_RADIANCE:L_RADIANCE + 3] = strength
             power[i] = strength.mean() * math.pi * scene_radius ** 2
+            row[L_IMPORTANCE] = strength.mean()
         elif li.type == "AREA":
             row[L_TYPE] = LT_AREA
             sx = float(li.size_x)
@@ -160,12 +168,14 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 norm_area = area if li.normalize else 1.0
                 row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * norm_area)
                 power[i] = strength.mean() * (1.0 if li.normalize else area)
+                row[L_IMPORTANCE] = power[i] / math.pi
             spread = float(li.spread)
             if spread < math.pi - 1e-6:
                 half = 0.5 * max(spread, 1e-4)
                 row[L_SPREAD_TAN] = math.tan(half)
                 row[L_SPREAD_NORM] = _spread_normalisation(half)
         row[L_FLAGS] = flags
+    table[:, L_IMPORTANCE] = np.maximum(table[:, L_IMPORTANCE], 0.0)
     return table, np.maximum(power, 0.0)
 
 
@@ -230,6 +240,40 @@ def area_spread(lamps, li, cos_l):
         return 0.0
     tan_theta = math.sqrt(max(0.0, 1.0 - cos_l * cos_l)) / cos_l
     return max(t - tan_theta, 0.0) * lamps[li, L_SPREAD_NORM]
+
+
+@device
+def lamp_importance(lamps, li, px, py, pz):
+    """Rough irradiance lamp li gives at p, ignoring occlusion and the surface's facing.
+
+    Used to pick the light for next-event estimation at p: near lamps and
+    spots pointing at p are picked more often.  Zero only where the lamp
+    cannot contribute at all (behind a one-sided area light).
+    """
+    k = lamps[li, L_IMPORTANCE]
+    typ = int(lamps[li, L_TYPE])
+    if k <= 0.0 or typ == LT_SUN:
+        return k
+    dx, dy, dz = px - lamps[li, L_POS], py - lamps[li, L_POS + 1], pz - lamps[li, L_POS + 2]
+    d2 = dx * dx + dy * dy + dz * dz
+    if typ == LT_AREA:
+        s = -(dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2])
+        if s <= 0.0:
+            return 0.0            # behind the emitting side: no light at all
+        cos_l = s / math.sqrt(d2)
+        return k * max(cos_l, IMPORTANCE_FLOOR) / max(d2, lamps[li, L_AREA])
+    att = 1.0
+    if typ == LT_SPOT:
+        att = max(spot_attenuation(lamps, li, dx, dy, dz), IMPORTANCE_FLOOR)
+    r = lamps[li, L_RADIUS]
+    return k * att / max(d2, r * r, 1e-12)
+
+
+@device
+def group_importance(group, px, py, pz):
+    """Irradiance estimate of all emissive triangles together: (cx, cy, cz, r^2, scale)."""
+    dx, dy, dz = px - group[0], py - group[1], pz - group[2]
+    return group[4] / max(dx * dx + dy * dy + dz * dz, group[3])
 
 
 @device

@@ -43,6 +43,7 @@ from .scene import SceneDescription, SceneError
 DEFAULT_BATCH = 1 << 17       # paths per chunk: ~50 MB of buffers per worker
 PASS_PATHS = 1 << 21          # a pass grows until it holds about this many paths
 MIN_CHUNK_PATHS = 1 << 12     # below this, per-call overhead dominates
+LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
 
 @dataclass
@@ -211,6 +212,15 @@ def build_scene_data(scene: SceneDescription):
     emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
     if emit_cdf[-1] > 0:
         emit_cdf /= emit_cdf[-1]
+    # The emissive triangles as one light for per-point picking: its centre,
+    # its radius squared (the distance floor) and an irradiance scale.
+    emit_group = np.zeros(5)
+    if len(emit_tri):
+        corners = verts[tris[emit_tri]].reshape(-1, 3)
+        lo_e, hi_e = corners.min(axis=0), corners.max(axis=0)
+        emit_group[:3] = 0.5 * (lo_e + hi_e)
+        emit_group[3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
+        emit_group[4] = emit_power.sum() / math.pi
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
     feats = features_mod.detect(scene, len(emit_tri), lamp_power)
@@ -222,7 +232,8 @@ def build_scene_data(scene: SceneDescription):
         verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
         mat_index=mat_index, materials=materials,
         lamps=lamps,
-        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf, tri_light=tri_light,
+        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf,
+        emit_group=emit_group, tri_light=tri_light,
         tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
         filter_table=filter_table(film.filter_type, film.filter_width))
 
@@ -246,6 +257,12 @@ def build_scene_data(scene: SceneDescription):
     # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.
     fcfg[K.FCFG_CLAMP_DIRECT] = 3.0 * it.clamp_direct if it.clamp_direct > 0 else math.inf
     fcfg[K.FCFG_CLAMP_INDIRECT] = 3.0 * it.clamp_indirect if it.clamp_indirect > 0 else math.inf
+    emit_share = float(emit_pmf.sum())
+    fcfg[K.FCFG_EMIT_SCALE] = 1.0 / emit_share if emit_share > 0 else 0.0
+    # Per-point light picking pays for itself when there is a choice to make and
+    # the scan over lamps stays short.
+    n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
+    cfg[K.CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
     return sc, cfg, fcfg, feats
 
 

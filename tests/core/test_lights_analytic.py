@@ -224,3 +224,29 @@ def test_emissive_panel_seen_at_grazing_angles(receiver):
     scene.materials = [Material(base_color=(1, 1, 1)), Material(base_color=(0, 0, 0), emission=(1, 1, 1))]
     expected = lambert(_panel_irradiance(quad, np.array([x, y, 0.0])))
     assert_mean(render(scene), expected, max_rel_se=0.003)
+
+
+def test_lights_picked_per_point_add_up_to_the_sum_of_each_light():
+    """Several lights at once: next-event estimation picks one per sample by its
+    estimated irradiance at the point (a spot aimed away is almost never picked,
+    an area light facing away never).  The mean must still be the sum of every
+    light's irradiance: picking changes noise only."""
+    P1, P2, Pa = 1000.0, 500.0, 100.0
+    lights = [
+        Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P1,) * 3),
+        Light(type="POINT", matrix_world=translation(3.0, 0, 1.0), strength=(P2,) * 3),
+        Light(type="SPOT", matrix_world=translation(0, 0, 3.0) @ rotation_x(math.pi),
+              strength=(5000.0,) * 3, spot_size=math.radians(40)),          # points up
+        Light(type="AREA", matrix_world=translation(0, 0, H), strength=(Pa,) * 3, size_x=1.0),
+        Light(type="AREA", matrix_world=translation(0, 0, 1.0) @ rotation_x(math.pi),
+              strength=(800.0,) * 3, size_x=1.0),                          # faces up
+    ]
+    scene = plane_scene(lights[0], samples=512, size=0.002)
+    scene.lights = lights
+    d2 = 3.0 ** 2 + 1.0
+    E = (P1 / (4 * math.pi * H * H) + P2 / (4 * math.pi * d2) * (1.0 / math.sqrt(d2))
+         + _area_irradiance(1.0, 1.0, False, Pa))
+    s = render(scene)
+    from mcengine.integrator import CFG_LOCAL_LIGHTS
+    assert s.cfg[CFG_LOCAL_LIGHTS] == 1      # this scene picks lights per point
+    assert_mean(s, lambert(E), max_rel_se=0.003)

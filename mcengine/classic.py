@@ -85,6 +85,7 @@ def _push_child(nx, n_next, st, i, key, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz
     nx.transparent[n_next] = st.transparent[i]
     nx.flags[n_next] = flags
     nx.mis_pdf[n_next] = mis_pdf
+    nx.mis_p[n_next, 0], nx.mis_p[n_next, 1], nx.mis_p[n_next, 2] = hx, hy, hz
     nx.self_prim[n_next] = p
     ox, oy, oz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
     set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
@@ -104,6 +105,8 @@ def _copy_node(nx, n_next, st, i, advance):
     nx.transparent[n_next] = st.transparent[i]
     nx.flags[n_next] = st.flags[i]
     nx.mis_pdf[n_next] = st.mis_pdf[i]
+    for c in range(3):
+        nx.mis_p[n_next, c] = st.mis_p[i, c]
     nx.self_prim[n_next] = st.self_prim[i]
     dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
     set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
@@ -143,7 +146,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
         if lamps_hit:
             lr, lg, lb, passed = lamps_on_segment(
                 sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, st.mis_pdf[i], PMF_EVERY,
-                0.0, 0.0, 0.0, 0.0, cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+                st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2], 0.0,
+                cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
             if passed:
                 add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
                 if st.transparent[i] + passed >= cfg[CFG_MAX_TRANSPARENT]:

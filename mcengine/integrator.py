@@ -410,7 +410,8 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
         for li in range(n_lamps):
             if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
                 continue
-            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit)
+            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
+                                                  mpx, mpy, mpz)
             if tl > last_t and tl < t_hit:
                 n_hits += 1
                 if tl < best_t:

@@ -1,7 +1,12 @@
 """numba compilation settings shared by every kernel of the core.
 
-* ``cache=True``: compiled machine code is stored next to the sources, so a
-  second process loads it in a fraction of a second instead of recompiling.
+* ``cache=True``: compiled machine code is stored on disk, so a second
+  process loads it in a fraction of a second instead of recompiling.  numba
+  keys its cache on the file of each function only, so a kernel would keep
+  the stale code of a helper it inlined from another file; the cache
+  therefore lives in a folder named after a hash of all the core's sources
+  (``__pycache__/numba-<hash>`` next to them, or ``~/.cache/mcengine`` if
+  that is not writable; ``NUMBA_CACHE_DIR`` still wins).
 * ``error_model="numpy"``: float division by zero gives inf/NaN instead of
   raising, which removes a branch from every division; the integrator checks
   the values it uses (``_clamp`` drops non-finite contributions).
@@ -19,7 +24,50 @@
   kernels never allocate or return arrays; the caller's references keep
   every array they touch alive.
 """
-from numba import njit
+import hashlib
+import os
+import shutil
+from pathlib import Path
 
-device = njit(cache=True, error_model="numpy", inline="always", _nrt=False)
-kernel = njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+from numba import njit
+from numba.core import config
+
+
+def _cache_dir() -> str | None:
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return None
+    here = Path(__file__).resolve().parent
+    digest = hashlib.sha256()
+    for source in sorted(here.glob("*.py")):
+        digest.update(source.name.encode())
+        digest.update(source.read_bytes())
+    base = here / "__pycache__"
+    if not os.access(here, os.W_OK):
+        base = Path.home() / ".cache" / "mcengine"
+    current = base / f"numba-{digest.hexdigest()[:16]}"
+    for old in base.glob("numba-*"):      # caches of earlier versions of the sources
+        if old != current:
+            shutil.rmtree(old, ignore_errors=True)
+    return str(current)
+
+
+_CACHE_DIR = _cache_dir()
+
+
+def _cached(decorator):
+    """Apply a numba decorator with the cache folder above (set only meanwhile:
+    numba's setting is process-wide and other packages keep theirs)."""
+    def apply(fn):
+        if _CACHE_DIR is None:
+            return decorator(fn)
+        previous = config.CACHE_DIR
+        config.CACHE_DIR = _CACHE_DIR
+        try:
+            return decorator(fn)
+        finally:
+            config.CACHE_DIR = previous
+    return apply
+
+
+device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=False))
+kernel = _cached(njit(cache=True, nogil=True, error_model="numpy", _nrt=False))

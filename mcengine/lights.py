@@ -277,6 +277,40 @@ def group_importance(group, px, py, pz):
 
 
 @device
+def spread_window(lamps, li, px, py, pz):
+    """The part of an area light with spread that can light p, as a rectangle.
+
+    With spread s < 180 deg, a point of the light shines on p only if p lies
+    within s/2 of the light's normal as seen from that point, i.e. the point
+    lies in a circle of radius t tan(s/2) around p's foot on the light's plane
+    (t: p's distance to the plane).  Returns the light-plane rectangle
+    ``(x0, x1, y0, y1)`` (local coordinates, metres) bounding that circle and
+    the light, and its area; area 0 if p cannot be lit.  Without spread, or
+    when the circle covers the whole light, the window is the whole light and
+    the area returned is the light's own (an ellipse is then sampled as one).  Sampling only this window is what Cycles does
+    (area.h, area_light_spread_clamp_light); it changes noise, not the mean.
+    """
+    hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
+    tan_half = lamps[li, L_SPREAD_TAN]
+    if tan_half < 0.0:
+        return -hx, hx, -hy, hy, lamps[li, L_AREA]
+    dx, dy, dz = px - lamps[li, L_POS], py - lamps[li, L_POS + 1], pz - lamps[li, L_POS + 2]
+    t = -(dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2])
+    if t <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    fx = dx * lamps[li, L_AX] + dy * lamps[li, L_AX + 1] + dz * lamps[li, L_AX + 2]
+    fy = dx * lamps[li, L_AY] + dy * lamps[li, L_AY + 1] + dz * lamps[li, L_AY + 2]
+    r = t * tan_half
+    x0, x1 = max(-hx, fx - r), min(hx, fx + r)
+    y0, y1 = max(-hy, fy - r), min(hy, fy + r)
+    if x1 <= x0 or y1 <= y0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    if x0 == -hx and x1 == hx and y0 == -hy and y1 == hy:
+        return x0, x1, y0, y1, lamps[li, L_AREA]     # not clipped: the whole light
+    return x0, x1, y0, y1, (x1 - x0) * (y1 - y0)
+
+
+@device
 def sample_lamp(lamps, li, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
 
@@ -305,10 +339,27 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
         if lamps[li, L_AREA] <= 0.0:
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        if lamps[li, L_ELLIPSE] > 0.0:
+        sample_area = lamps[li, L_AREA]
+        inside = True
+        clipped = False
+        if lamps[li, L_SPREAD_TAN] >= 0.0:
+            x0, x1, y0, y1, sample_area = spread_window(lamps, li, px, py, pz)
+            if sample_area <= 0.0:
+                return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            clipped = sample_area != lamps[li, L_AREA]
+        if clipped:
+            # Spread: sample the window of the light that can reach p, uniformly
+            # (points of an ellipse's window outside the ellipse give nothing).
+            ax, by_ = x0 + u1 * (x1 - x0), y0 + u2 * (y1 - y0)
+            if lamps[li, L_ELLIPSE] > 0.0:
+                inside = (ax / hx) ** 2 + (by_ / hy) ** 2 <= 1.0
+            a, b = ax / hx, by_ / hy
+        elif lamps[li, L_ELLIPSE] > 0.0:
             a, b = disk_concentric(u1, u2)
         else:
             a, b = 2.0 * u1 - 1.0, 2.0 * u2 - 1.0
+        if not inside:
+            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
         qx = cx + a * hx * lamps[li, L_AX] + b * hy * lamps[li, L_AY]
         qy = cy + a * hx * lamps[li, L_AX + 1] + b * hy * lamps[li, L_AY + 1]
         qz = cz + a * hx * lamps[li, L_AX + 2] + b * hy * lamps[li, L_AY + 2]
@@ -323,7 +374,7 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         if cos_l <= 0.0:
             return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
         s = area_spread(lamps, li, cos_l)
-        pdf = d2 / (lamps[li, L_AREA] * cos_l)
+        pdf = d2 / (sample_area * cos_l)
         return (wx, wy, wz, dist, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1],
                 s * lamps[li, L_RADIANCE + 2], pdf)
 
@@ -382,11 +433,12 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
 
 
 @device
-def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax):
+def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
     """A ray through a lamp: ``(t, Lr, Lg, Lb, pdf)``, t = inf if it misses.
 
     ``pdf`` is the solid-angle pdf with which :func:`sample_lamp` would pick
-    this direction from the ray origin (for MIS).  Suns are handled by
+    this direction from the ray's vertex v (the surface point the ray left,
+    before its origin was offset), for MIS.  Suns are handled by
     :func:`sun_radiance` on escaped rays.
     """
     typ = int(lamps[li, L_TYPE])
@@ -410,7 +462,14 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax):
         elif abs(a) > 1.0 or abs(b) > 1.0:
             return math.inf, 0.0, 0.0, 0.0, 0.0
         s = area_spread(lamps, li, cos_l)
-        pdf = t * t / (lamps[li, L_AREA] * cos_l)
+        sample_area = lamps[li, L_AREA]
+        if lamps[li, L_SPREAD_TAN] >= 0.0:
+            # The light sampler only draws from the spread window seen from v.
+            x0, x1, y0, y1, sample_area = spread_window(lamps, li, vx, vy, vz)
+            ax, by_ = a * lamps[li, L_HALF_X], b * lamps[li, L_HALF_Y]
+            if sample_area <= 0.0 or ax < x0 or ax > x1 or by_ < y0 or by_ > y1:
+                return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], 0.0
+        pdf = t * t / (sample_area * cos_l)
         return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], pdf
 
     r = lamps[li, L_RADIUS]

@@ -250,3 +250,29 @@ def test_lights_picked_per_point_add_up_to_the_sum_of_each_light():
     from mcengine.integrator import CFG_LOCAL_LIGHTS
     assert s.cfg[CFG_LOCAL_LIGHTS] == 1      # this scene picks lights per point
     assert_mean(s, lambert(E), max_rel_se=0.003)
+
+
+@pytest.mark.parametrize("shape", ["RECTANGLE", "ELLIPSE"])
+def test_narrow_spread_sampling_window_is_unbiased(shape):
+    """A 2 x 1.2 m light with a 20 deg spread, 2 m above a receiver off its centre.
+
+    Only a window of the light (a circle of radius 2 tan 10 deg around the
+    receiver's foot point) can reach the receiver; the light sampler draws
+    from that window alone.  The mean must equal the integral over the whole
+    light of the spread-attenuated radiance."""
+    sx, sy, s_half = 2.0, 1.2, math.radians(10.0)
+    rx, ry = 0.5, 0.3
+    li = Light(type="AREA", matrix_world=translation(0, 0, H), strength=(100.0,) * 3, shape=shape,
+               size_x=sx, size_y=sy, spread=2 * s_half)
+    scene = plane_scene(li, samples=2048, size=0.002)
+    scene.camera.matrix_world = translation(rx, ry, 5.0)
+    n = 1200
+    u = (np.arange(n) + 0.5) / n - 0.5
+    x, y = np.meshgrid(u * sx, u * sy)
+    inside = (4 * x * x / sx ** 2 + 4 * y * y / sy ** 2 <= 1.0) if shape == "ELLIPSE" else np.ones_like(x, bool)
+    area = sx * sy * (math.pi / 4 if shape == "ELLIPSE" else 1.0)
+    d2 = (x - rx) ** 2 + (y - ry) ** 2 + H * H
+    tan_t = np.sqrt((x - rx) ** 2 + (y - ry) ** 2) / H
+    factor = np.maximum(math.tan(s_half) - tan_t, 0) / (math.tan(s_half) - s_half)
+    E = float(np.sum(inside * factor * 100.0 / (math.pi * area) * H * H / (d2 * d2)) * sx * sy / n / n)
+    assert_mean(render(scene), lambert(E), max_rel_se=0.004)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from .jit import device
 
 CAM_PERSP = 0

@@ -29,12 +29,12 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from .jit import device, kernel
 
 from .bsdf import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
                    M_EMISSION, M_EMISSIVE, bsdf_eval, bsdf_has_lobes, bsdf_sample)
 from .camera import camera_ray
 from .intersect import SHADOW_SHORTEN, T_INFINITE, intersect_prim, offset_origin, offset_scale
+from .jit import device, kernel
 from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW,
                      group_importance, lamp_importance,
                      LF_USE_MIS, LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY,

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from .jit import device
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about

@@ -9,7 +9,7 @@
   that is not writable; ``NUMBA_CACHE_DIR`` still wins).
 * ``error_model="numpy"``: float division by zero gives inf/NaN instead of
   raising, which removes a branch from every division; the integrator checks
-  the values it uses (``_clamp`` drops non-finite contributions).
+  the values it uses (``clamp_light`` drops non-finite contributions).
 * ``nogil=True`` on stage kernels: two Python worker threads run them in
   parallel (no OpenMP pool whose spinning workers would steal the core that
   Embree runs on).

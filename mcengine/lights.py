@@ -35,8 +35,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from .jit import device
 
+from .jit import device
 from .sampling import (disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf,
                        uniform_triangle)
 

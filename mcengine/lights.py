@@ -310,95 +310,6 @@ def spread_window(lamps, li, px, py, pz):
     return x0, x1, y0, y1, (x1 - x0) * (y1 - y0)
 
 
-# Below this solid angle a rectangle is sampled by area (Cycles' threshold in
-# area.h): the spherical-rectangle formulas lose precision for tiny or
-# edge-on rectangles, and there the two strategies hardly differ.
-SPHERICAL_RECT_MIN = 1e-5
-
-
-@device
-def spherical_rect(lamps, li, px, py, pz):
-    """Solid-angle sampling set-up of rectangle lamp li seen from p.
-
-    Urena, Fajardo and King, "An Area-Preserving Parametrization for
-    Spherical Rectangles" (EGSR 2013).  In the lamp's frame centred at p the
-    rectangle spans [x0, x1] x [y0, y1] at height z0 (taken negative, as the
-    paper requires).  Returns ``(S, x0, x1, y0, y1, z0, b0, b1, k)`` with S the
-    solid angle; S = 0 for points in the lamp's plane.
-    """
-    hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
-    dx, dy, dz = lamps[li, L_POS] - px, lamps[li, L_POS + 1] - py, lamps[li, L_POS + 2] - pz
-    cx = dx * lamps[li, L_AX] + dy * lamps[li, L_AX + 1] + dz * lamps[li, L_AX + 2]
-    cy = dx * lamps[li, L_AY] + dy * lamps[li, L_AY + 1] + dz * lamps[li, L_AY + 2]
-    z0 = -abs(dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2])
-    x0, x1, y0, y1 = cx - hx, cx + hx, cy - hy, cy + hy
-    if z0 == 0.0:
-        return 0.0, x0, x1, y0, y1, z0, 0.0, 0.0, 0.0
-    # Unit normals of the four planes through p and the rectangle's edges
-    # (their zero components are omitted).
-    n0y, n0z = z0, -y0
-    m = 1.0 / math.sqrt(n0y * n0y + n0z * n0z)
-    n0z *= m
-    n1x, n1z = -z0, x1
-    m = 1.0 / math.sqrt(n1x * n1x + n1z * n1z)
-    n1z *= m
-    n2y, n2z = -z0, y1
-    m = 1.0 / math.sqrt(n2y * n2y + n2z * n2z)
-    n2z *= m
-    n3x, n3z = z0, -x0
-    m = 1.0 / math.sqrt(n3x * n3x + n3z * n3z)
-    n3z *= m
-    g0 = math.acos(min(max(-n0z * n1z, -1.0), 1.0))
-    g1 = math.acos(min(max(-n1z * n2z, -1.0), 1.0))
-    g2 = math.acos(min(max(-n2z * n3z, -1.0), 1.0))
-    g3 = math.acos(min(max(-n3z * n0z, -1.0), 1.0))
-    k = 2.0 * math.pi - g2 - g3
-    return g0 + g1 - k, x0, x1, y0, y1, z0, n0z, n2z, k
-
-
-@device
-def spherical_rect_sample(x0, x1, y0, y1, z0, b0, b1, k, solid_angle, u, v):
-    """Point (xu, yv) in the lamp's frame (at height z0) for uniform u, v."""
-    au = u * solid_angle + k
-    fu = (math.cos(au) * b0 - b1) / math.sin(au)
-    cu = 1.0 / math.sqrt(fu * fu + b0 * b0)
-    if fu <= 0.0:
-        cu = -cu
-    cu = min(max(cu, -1.0), 1.0)
-    xu = -(cu * z0) / math.sqrt(max(1.0 - cu * cu, 1e-30))
-    xu = min(max(xu, x0), x1)
-    d = math.sqrt(xu * xu + z0 * z0)
-    h0 = y0 / math.sqrt(d * d + y0 * y0)
-    h1 = y1 / math.sqrt(d * d + y1 * y1)
-    hv = h0 + v * (h1 - h0)
-    hv2 = hv * hv
-    yv = hv * d / math.sqrt(1.0 - hv2) if hv2 < 1.0 - 1e-9 else y1
-    return xu, min(max(yv, y0), y1)
-
-
-@device
-def _spherical_rect_light(lamps, li, px, py, pz, u1, u2, solid_angle, x0, x1, y0, y1, z0,
-                          b0, b1, k):
-    """sample_lamp's result for a rectangle sampled by solid angle (pdf 1 / S)."""
-    xu, yv = spherical_rect_sample(x0, x1, y0, y1, z0, b0, b1, k, solid_angle, u1, u2)
-    # Back to world space; z0 was made negative, the lamp's side of p is +-AZ.
-    side = lamps[li, L_POS] - px, lamps[li, L_POS + 1] - py, lamps[li, L_POS + 2] - pz
-    zs = -z0 if side[0] * lamps[li, L_AZ] + side[1] * lamps[li, L_AZ + 1] + side[2] * lamps[li, L_AZ + 2] > 0.0 else z0
-    dx = xu * lamps[li, L_AX] + yv * lamps[li, L_AY] + zs * lamps[li, L_AZ]
-    dy = xu * lamps[li, L_AX + 1] + yv * lamps[li, L_AY + 1] + zs * lamps[li, L_AZ + 1]
-    dz = xu * lamps[li, L_AX + 2] + yv * lamps[li, L_AY + 2] + zs * lamps[li, L_AZ + 2]
-    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-    if dist == 0.0:
-        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    wx, wy, wz = dx / dist, dy / dist, dz / dist
-    cos_l = wx * lamps[li, L_AZ] + wy * lamps[li, L_AZ + 1] + wz * lamps[li, L_AZ + 2]
-    if cos_l <= 0.0:
-        return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0    # behind the one-sided lamp
-    s = area_spread(lamps, li, cos_l)
-    return (wx, wy, wz, dist, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1],
-            s * lamps[li, L_RADIANCE + 2], 1.0 / solid_angle)
-
-
 @device
 def sample_lamp(lamps, li, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
@@ -446,10 +357,6 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         elif lamps[li, L_ELLIPSE] > 0.0:
             a, b = disk_concentric(u1, u2)
         else:
-            solid_angle, x0, x1, y0, y1, z0, b0, b1, k = spherical_rect(lamps, li, px, py, pz)
-            if solid_angle >= SPHERICAL_RECT_MIN:
-                return _spherical_rect_light(lamps, li, px, py, pz, u1, u2, solid_angle,
-                                             x0, x1, y0, y1, z0, b0, b1, k)
             a, b = 2.0 * u1 - 1.0, 2.0 * u2 - 1.0
         if not inside:
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -563,11 +470,6 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
             if sample_area <= 0.0 or ax < x0 or ax > x1 or by_ < y0 or by_ > y1:
                 return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], 0.0
         pdf = t * t / (sample_area * cos_l)
-        if lamps[li, L_ELLIPSE] == 0.0 and sample_area == lamps[li, L_AREA]:
-            # A whole rectangle (no spread window) is sampled by solid angle.
-            solid_angle = spherical_rect(lamps, li, vx, vy, vz)[0]
-            if solid_angle >= SPHERICAL_RECT_MIN:
-                pdf = 1.0 / solid_angle
         return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], pdf
 
     r = lamps[li, L_RADIUS]

@@ -252,15 +252,17 @@ def test_lights_picked_per_point_add_up_to_the_sum_of_each_light():
     assert_mean(s, lambert(E), max_rel_se=0.003)
 
 
-@pytest.mark.parametrize("shape", ["RECTANGLE", "ELLIPSE"])
-def test_narrow_spread_sampling_window_is_unbiased(shape):
-    """A 2 x 1.2 m light with a 20 deg spread, 2 m above a receiver off its centre.
+@pytest.mark.parametrize("shape,spread_deg", [("RECTANGLE", 20.0), ("ELLIPSE", 20.0),
+                                              ("RECTANGLE", 140.0)])
+def test_spread_sampling_window_is_unbiased(shape, spread_deg):
+    """A 2 x 1.2 m light with spread, 2 m above a receiver off its centre.
 
-    Only a window of the light (a circle of radius 2 tan 10 deg around the
-    receiver's foot point) can reach the receiver; the light sampler draws
-    from that window alone.  The mean must equal the integral over the whole
-    light of the spread-attenuated radiance."""
-    sx, sy, s_half = 2.0, 1.2, math.radians(10.0)
+    At 20 deg only a window of the light (a circle of radius 2 tan 10 deg
+    around the receiver's foot point) can reach the receiver, and the light
+    sampler draws from that window alone; at 140 deg the window is the whole
+    light.  The mean must equal the integral over the whole light of the
+    spread-attenuated radiance."""
+    sx, sy, s_half = 2.0, 1.2, math.radians(spread_deg / 2)
     rx, ry = 0.5, 0.3
     li = Light(type="AREA", matrix_world=translation(0, 0, H), strength=(100.0,) * 3, shape=shape,
                size_x=sx, size_y=sy, spread=2 * s_half)

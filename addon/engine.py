@@ -31,7 +31,7 @@ log = logging.getLogger(__name__)
 
 def default_session_factory(scene, threads=None):
     """Create the core's render session (imported lazily: it loads numba kernels)."""
-    from mcengine.render import RenderSession
+    from mcengine.session import RenderSession
     return RenderSession(scene, threads=threads)
 
 

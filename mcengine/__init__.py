@@ -2,7 +2,7 @@
 
 The core never imports Blender.  A render is described by a
 :class:`mcengine.scene.SceneDescription` (plain numpy data, savable to .npz)
-and produced by :class:`mcengine.render.RenderSession`.
+and produced by :class:`mcengine.session.RenderSession`.
 
 Conventions used throughout the core:
 

@@ -44,7 +44,7 @@ def load_addon_from_folder(name: str):
 
 
 class GradientSession:
-    """Stand-in for ``mcengine.render.RenderSession``.
+    """Stand-in for ``mcengine.session.RenderSession``.
 
     Fills a known, asymmetric image over ``passes`` passes: pixel (row r from
     the top, column c) converges to (c, r, c + 100 r, 1); after pass k of n the

@@ -17,7 +17,7 @@ Z_LIMIT = 4.4
 
 
 def render(scene, **kw):
-    from mcengine.render import RenderSession
+    from mcengine.session import RenderSession
     return RenderSession(scene, **kw).run()
 
 

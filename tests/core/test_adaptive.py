@@ -10,7 +10,7 @@ converged reference must satisfy mean(e^2) <= t^2 over the image.
 import numpy as np
 import pytest
 
-from mcengine.render import RenderSession
+from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
 
 from .scenes import grid_plane, translation

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from mcengine.render import RenderSession
+from mcengine.session import RenderSession
 from mcengine.scene import (Camera, Film, Geometry, Integrator, Light, Material, SceneDescription,
                             SceneError, World)
 

@@ -15,7 +15,7 @@ from .scenes import inside_sphere_scene
 
 
 def test_core_never_imports_blender():
-    code = ("import sys, mcengine, mcengine.render, mcengine.compare, mcengine.imageio;"
+    code = ("import sys, mcengine, mcengine.session, mcengine.compare, mcengine.imageio;"
             "print(any(m in sys.modules for m in ('bpy', 'mathutils')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

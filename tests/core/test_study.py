@@ -15,7 +15,7 @@ import pytest
 
 from mcengine import study as S
 from mcengine.compare import relmse
-from mcengine.render import RenderSession
+from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
 
 from .scenes import grid_plane, translation

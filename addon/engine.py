@@ -53,9 +53,6 @@ class MCEngine(bpy.types.RenderEngine):
     # Material Preview viewport shading uses EEVEE, as for Cycles.
     bl_use_eevee_viewport = True
 
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-
     def render(self, depsgraph):
         if self.is_preview:
             return  # bl_use_preview is False; nothing to draw for material previews
@@ -95,7 +92,6 @@ class MCEngine(bpy.types.RenderEngine):
         log.info("scene exported in %.3f s", seconds)
         for warning in exported.scene.warnings:
             self.report({"WARNING"}, warning)
-        _store_effects(depsgraph.scene.original, exported)
         # The first render after installing compiles the numba kernels (cached afterwards).
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "
                               f"render compiles its kernels, about a minute)")
@@ -107,6 +103,7 @@ class MCEngine(bpy.types.RenderEngine):
         except Exception as exc:
             self._fail(_describe(exc, "preparing the renderer"), exc)
             return None, None
+        _store_effects(depsgraph.scene.original, session.features, exported.ignored)
         return exported.scene, session
 
     def _publish(self, result, session, progress) -> None:
@@ -201,16 +198,16 @@ def _describe(exc: Exception, doing: str) -> str:
     return f"failed while {doing}: {type(exc).__name__}: {exc}".splitlines()[0]
 
 
-def _store_effects(scene, exported) -> None:
-    """Remember what the render used for the MC Engine panel.
+def _store_effects(scene, features, ignored) -> None:
+    """Remember what the render used (its ``Features``) and ignored, for the MC Engine panel.
 
     Written as ID properties rather than through RNA: the render may run off the
     main thread, and RNA updates would send notifiers from it.
     """
     settings = getattr(scene, "mcengine", None)
     if settings is not None:
-        settings["last_effects"] = exported.effects()
-        settings["last_ignored"] = ", ".join(exported.ignored)
+        settings["last_effects"] = features.summary()
+        settings["last_ignored"] = ", ".join(ignored)
 
 
 def register() -> None:

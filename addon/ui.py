@@ -54,7 +54,7 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
         if not settings.last_effects:
             col.label(text="Not rendered yet", icon="INFO")
             return
-        col.label(text=f"Effects: {settings.last_effects}", icon="SHADING_RENDERED")
+        col.label(text=settings.last_effects, icon="SHADING_RENDERED")
         if settings.last_ignored:
             col.label(text=f"Ignored: {settings.last_ignored}", icon="ERROR")
         accounting = settings.get("last_accounting")

@@ -9,7 +9,7 @@ and only the projection decides where things land.
 Camera: orthographic, ortho_scale 6.5, fit HORIZONTAL, at (3.0, -4.0, 5.0)
 looking at (0.0, 0.2, 0.3), shift (-0.06, 0.04).
 
-Run: /work/venv/bin/python blend_scenes/camera_ortho.py
+Run: .venv/bin/python blend_scenes/camera_ortho.py
 """
 import math
 

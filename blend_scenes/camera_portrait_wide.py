@@ -9,7 +9,7 @@ two area lights and a dim world.
 Camera: 80 x 128 frame, at (0.0, -3.4, 2.0) looking level along +Y; lens
 20 mm, sensor width 36 mm, fit AUTO, shift (0.0, -0.3).
 
-Run: /work/venv/bin/python blend_scenes/camera_portrait_wide.py
+Run: .venv/bin/python blend_scenes/camera_portrait_wide.py
 """
 import _common as c
 

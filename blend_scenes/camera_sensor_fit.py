@@ -9,7 +9,7 @@ a fraction of the larger frame side).  The light-scene stage, lit by a sun
 Camera: at (0.6, -5.6, 3.4) looking at (0.3, 0.3, 0.4); lens 35 mm, sensor
 36 x 20 mm, fit VERTICAL, shift (0.12, -0.08).
 
-Run: /work/venv/bin/python blend_scenes/camera_sensor_fit.py
+Run: .venv/bin/python blend_scenes/camera_sensor_fit.py
 """
 import math
 

@@ -11,7 +11,7 @@ y = -1, back wall at y = +1) and z = 0..2.  The camera looks along +Y through
 the open front.  All surfaces are flat-shaded quads with normals facing into
 the room.
 
-Run: /work/venv/bin/python blend_scenes/cornell_box.py  (writes cornell_box.blend)
+Run: .venv/bin/python blend_scenes/cornell_box.py  (writes cornell_box.blend)
 """
 import math
 

@@ -13,7 +13,7 @@ sphere are smooth enough to compare at a few hundred samples.
 * ``Cube``: Mix Shader of its Lambert Principled BSDF (0.7) and a mirror (0.3).
 * ``Panel``: area light 2 m square, 150 W, 3 m up.
 
-Run: /work/venv/bin/python blend_scenes/glass_mirror.py
+Run: .venv/bin/python blend_scenes/glass_mirror.py
 """
 import math
 

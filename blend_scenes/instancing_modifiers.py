@@ -22,7 +22,7 @@ a grey world of 0.03, one area light and:
 * ``SolidPanel``: a single quad made 0.15 m thick by a Solidify modifier,
   standing tilted.
 
-Run: /work/venv/bin/python blend_scenes/instancing_modifiers.py
+Run: .venv/bin/python blend_scenes/instancing_modifiers.py
 """
 import math
 

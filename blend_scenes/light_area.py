@@ -12,7 +12,7 @@ and ``visible_camera``.  World black.
 * ``AreaEllipse``: ELLIPSE 1.2 x 0.5 m, pale blue, standing behind the objects
   facing the camera, ``visible_camera`` True, so it is seen in the frame.
 
-Run: /work/venv/bin/python blend_scenes/light_area.py
+Run: .venv/bin/python blend_scenes/light_area.py
 """
 import math
 

@@ -15,7 +15,7 @@ scale and a spread light seen directly.  World black.
   standing behind the objects facing the camera, ``visible_camera`` True (the
   camera sees it only inside its spread cone).
 
-Run: /work/venv/bin/python blend_scenes/light_area_spread.py
+Run: .venv/bin/python blend_scenes/light_area_spread.py
 """
 import math
 

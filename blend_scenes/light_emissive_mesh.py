@@ -8,7 +8,7 @@ direct visibility.  No lamps; world black.
 * ``GlowPanel``: a 2.0 x 0.8 m quad 1.8 m up, tilted 35 deg, white-blue,
   strength 12; the camera sees its upper (back) side, which emits too.
 
-Run: /work/venv/bin/python blend_scenes/light_emissive_mesh.py
+Run: .venv/bin/python blend_scenes/light_emissive_mesh.py
 """
 import math
 

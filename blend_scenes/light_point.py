@@ -5,7 +5,7 @@ shadows) and the 5.0 default soft point light (radius 0.3 with
 ``use_soft_falloff`` True: a disk facing the shading point, soft shadows),
 light colour, and an otherwise black world.
 
-Run: /work/venv/bin/python blend_scenes/light_point.py  (writes light_point.blend)
+Run: .venv/bin/python blend_scenes/light_point.py  (writes light_point.blend)
 """
 import _common as c
 

@@ -11,7 +11,7 @@ the camera.  World black.
 * ``SoftBig``: 120 W, orange, radius 0.7, ``use_soft_falloff`` True, 0.6 m
   above and behind the sphere, ``visible_camera`` True.
 
-Run: /work/venv/bin/python blend_scenes/light_point_large.py
+Run: .venv/bin/python blend_scenes/light_point_large.py
 """
 import _common as c
 

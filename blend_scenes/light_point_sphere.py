@@ -4,7 +4,7 @@ Tests the true spherical point light (uniform radiance P/(4 pi^2 r^2) over a
 sphere of radius r, irradiance P/(4 pi d^2) outside it), its soft shadows, and
 ``visible_camera`` True: the glowing sphere itself is in the frame.  World black.
 
-Run: /work/venv/bin/python blend_scenes/light_point_sphere.py
+Run: .venv/bin/python blend_scenes/light_point_sphere.py
 """
 import _common as c
 

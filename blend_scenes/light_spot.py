@@ -8,7 +8,7 @@ floor in view; outside them only indirect light remains (world black).
 * ``SpotHard``: spot_size 45 deg, blend 0, radius 0 (hard edge, hard shadows).
 * ``SpotSoft``: spot_size 70 deg, blend 0.4, radius 0.2, bluish.
 
-Run: /work/venv/bin/python blend_scenes/light_spot.py
+Run: .venv/bin/python blend_scenes/light_spot.py
 """
 import math
 

@@ -13,7 +13,7 @@ sphere light, and the extreme blend and cone settings.  World black.
 * ``SpotWide``: 250 W, spot_size 150 deg, blend 1.0, radius 0.1 (soft
   falloff), bluish, low over the sphere.
 
-Run: /work/venv/bin/python blend_scenes/light_spot_shapes.py
+Run: .venv/bin/python blend_scenes/light_spot_shapes.py
 """
 import math
 

@@ -4,7 +4,7 @@ Tests the distant light (``energy`` is irradiance in W/m^2 on a surface facing
 it, ``angle`` its full angular diameter, so shadows are slightly soft) and a
 constant world of 0.02 that fills the shadows.
 
-Run: /work/venv/bin/python blend_scenes/light_sun.py
+Run: .venv/bin/python blend_scenes/light_sun.py
 """
 import math
 

@@ -10,7 +10,7 @@ shadows hold only indirect light.
 * ``SunWide``: 4 W/m^2, warm, angle 30 deg, 35 deg from the zenith.
 * ``SunNarrow``: 1.5 W/m^2, blue, angle 2 deg, 55 deg from the zenith.
 
-Run: /work/venv/bin/python blend_scenes/light_sun_wide.py
+Run: .venv/bin/python blend_scenes/light_sun_wide.py
 """
 import math
 

@@ -1,6 +1,6 @@
 """Regenerate every scene: run each ``blend_scenes/<name>.py`` in its own process.
 
-Usage: /work/venv/bin/python blend_scenes/make_all.py [NAME ...]
+Usage: .venv/bin/python blend_scenes/make_all.py [NAME ...]
 
 Each generator resets Blender to factory settings, but a fresh interpreter per
 scene also keeps add-on and module state from leaking between scenes.  Without

@@ -2,7 +2,7 @@
 
 Usage::
 
-    /work/venv/bin/python blend_scenes/render_cycles.py OUT_DIR [FILE.blend ...]
+    .venv/bin/python blend_scenes/render_cycles.py OUT_DIR [FILE.blend ...]
 
 Without files, every ``blend_scenes/*.blend`` is rendered.  For each file the
 image is written twice into OUT_DIR: ``<name>.exr`` (32-bit float, scene

@@ -18,7 +18,7 @@ of 0.05 and these objects:
 * ``MirroredGlow``: an emissive quad (two-sided) with scale (-1.5, 0.5, 1.0),
   tilted 30 deg.
 
-Run: /work/venv/bin/python blend_scenes/transforms.py
+Run: .venv/bin/python blend_scenes/transforms.py
 """
 import math
 

@@ -4,7 +4,7 @@ Tests background lighting and its importance sampling, ambient-occlusion-like
 shading of the floor and objects, and the world seen directly (the camera is
 lower than in the other stages so the sky shows above the horizon).
 
-Run: /work/venv/bin/python blend_scenes/world_color.py
+Run: .venv/bin/python blend_scenes/world_color.py
 """
 import _common as c
 

@@ -3,9 +3,9 @@
 The render asks this module before it starts, so that no work is done for
 what the scene does not contain: no shadow rays without lights, no lamp
 intersection tests when no lamp can be hit, no background lookups for a black
-world.  Glossy (mirror, glass) and transmissive lobes are found from the materials
-the triangles use; depth of field and motion blur are not supported yet and
-are always absent.
+world.  The lobes (diffuse, sharp reflection, refraction) are found from the
+materials the triangles use.  ``summary()`` is the line the MC Engine panel
+shows ("Effects: ...").
 """
 from __future__ import annotations
 
@@ -22,24 +22,23 @@ class Features:
     world: bool = False            # the background is not black
     lamps_hit: bool = False        # some lamp can be hit by camera or BSDF rays
     nee: bool = False              # something to sample with next-event estimation
-    depth_of_field: bool = False
-    motion_blur: bool = False
-    glossy: bool = False
-    transmission: bool = False
+    diffuse: bool = False          # some surface has a diffuse lobe
+    glossy: bool = False           # ... a mirror or glass lobe
+    transmission: bool = False     # ... a glass or refraction lobe
 
     def summary(self) -> str:
         """One line for the UI and the logs."""
         lights = [f"{n} {t.lower()}" for t, n in sorted(self.lamp_types.items())]
         if self.emissive_triangles:
-            lights.append(f"{self.emissive_triangles} emissive triangles")
+            n = self.emissive_triangles
+            lights.append(f"{n} emissive triangle{'s' if n > 1 else ''}")
         if self.world:
             lights.append("world")
-        effects = [name for name, on in (("depth of field", self.depth_of_field),
-                                         ("motion blur", self.motion_blur),
-                                         ("sharp reflection", self.glossy),
-                                         ("refraction", self.transmission)) if on]
+        lobes = [name for name, on in (("diffuse", self.diffuse),
+                                       ("sharp reflection", self.glossy),
+                                       ("refraction", self.transmission)) if on]
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
-                f"effects: {', '.join(effects) if effects else 'diffuse only'}")
+                f"surfaces: {', '.join(lobes) if lobes else 'black'}")
 
 
 def lamp_can_be_hit(light) -> bool:
@@ -60,6 +59,7 @@ def detect(scene, emissive_triangles: int, lamp_power) -> Features:
     mats = [m for i, m in enumerate(scene.materials) if i in used]
     has = lambda attr: any(max(getattr(m, attr)) > 0.0 for m in mats)  # noqa: E731
     return Features(
+        diffuse=has("base_color"),
         glossy=has("mirror_color") or has("glass_color"),
         transmission=has("glass_color") or has("refraction_color"),
         lamp_types=dict(Counter(li.type for li in lamps)),

@@ -94,14 +94,3 @@ def write_png(path, image, exposure: float = 0.0) -> None:
         Path(path).write_bytes(png)
     except OSError as exc:
         raise ImageError(f"cannot write {path}: {exc.strerror}") from None
-
-
-def write_image(path, rgba) -> None:
-    """Write by extension: .exr (linear float) or .png (display)."""
-    suffix = Path(path).suffix.lower()
-    if suffix == ".exr":
-        write_exr(path, rgba)
-    elif suffix == ".png":
-        write_png(path, rgba)
-    else:
-        raise ImageError(f"{path}: unknown image type {suffix!r} (use .exr or .png)")

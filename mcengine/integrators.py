@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["IntegratorInfo", "INTEGRATORS", "NAMES", "DEFAULT", "DEPTH_RANGE", "BRANCHING_RANGE",
-           "DEFAULT_DEPTH", "DEFAULT_BRANCHING", "get", "from_enum"]
+           "DEFAULT_DEPTH", "DEFAULT_BRANCHING", "get", "from_enum", "check_parameters"]
 
 DEPTH_RANGE = (1, 16)          # ray levels of Whitted and distribution ray tracing
 BRANCHING_RANGE = (1, 64)      # secondary rays per hit of distribution ray tracing

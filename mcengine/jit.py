@@ -2,11 +2,13 @@
 
 * ``cache=True``: compiled machine code is stored on disk, so a second
   process loads it in a fraction of a second instead of recompiling.  numba
-  keys its cache on the file of each function only, so a kernel would keep
-  the stale code of a helper it inlined from another file; the cache
-  therefore lives in a folder named after a hash of all the core's sources
-  (``__pycache__/numba-<hash>`` next to them, or ``~/.cache/mcengine`` if
-  that is not writable; ``NUMBA_CACHE_DIR`` still wins).
+  keys its cache on the file of each function only (and not on the jit
+  options), so a kernel would keep the stale code of a helper it inlined
+  from another file; the cache therefore lives in a folder named after a
+  hash of every source that compiled code comes from (this file and the
+  ``kernels`` package: ``__pycache__/numba-<hash>`` next to them, or
+  ``~/.cache/mcengine`` if that is not writable; ``NUMBA_CACHE_DIR`` still
+  wins).
 * ``error_model="numpy"``: float division by zero gives inf/NaN instead of
   raising, which removes a branch from every division; the integrator checks
   the values it uses (``clamp_light`` drops non-finite contributions).
@@ -38,8 +40,8 @@ def _cache_dir() -> str | None:
         return None
     here = Path(__file__).resolve().parent
     digest = hashlib.sha256()
-    for source in sorted(here.glob("*.py")):
-        digest.update(source.name.encode())
+    for source in [Path(__file__).resolve(), *sorted((here / "kernels").rglob("*.py"))]:
+        digest.update(str(source.relative_to(here)).encode())
         digest.update(source.read_bytes())
     base = here / "__pycache__"
     if not os.access(here, os.W_OK):

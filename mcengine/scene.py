@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import integrators
+
 __all__ = [
     "SceneError", "Geometry", "Material", "Light", "Camera", "World", "Film",
     "Integrator", "SceneDescription",
@@ -221,16 +223,16 @@ class Film:
 class Integrator:
     """Sampling and path settings, named as Cycles names them.
 
-    ``method`` chooses the algorithm (see :mod:`mcengine.classic`): "path"
-    (path tracing, the default and the only one that matches Cycles),
+    ``name`` chooses the algorithm, one of :data:`mcengine.integrators.NAMES`:
+    "path" (path tracing, the default and the only one that matches Cycles),
     "raycast", "whitted" (mirror and refraction rays down to ``depth`` ray
     levels) or "distribution" (``branching`` rays at every hit, ``depth``
     levels).
     """
 
-    method: str = "path"
-    depth: int = 5
-    branching: int = 4
+    name: str = integrators.DEFAULT
+    depth: int = integrators.DEFAULT_DEPTH
+    branching: int = integrators.DEFAULT_BRANCHING
     samples: int = 64
     seed: int = 0
     max_bounces: int = 12
@@ -312,11 +314,11 @@ class SceneDescription:
         if c.type == "PERSP" and c.lens <= 0:
             raise SceneError("camera focal length must be positive")
         i = self.integrator
-        if i.method not in ("path", "raycast", "whitted", "distribution"):
-            raise SceneError(f"unknown integrator {i.method!r} (path, raycast, whitted, distribution)")
-        if i.depth < 1 or i.branching < 1:
-            raise SceneError(f"integrator depth and branching must be at least 1, got "
-                             f"{i.depth} and {i.branching}")
+        try:
+            integrators.get(i.name)
+            integrators.check_parameters(i.depth, i.branching)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
         if i.samples < 1:
             raise SceneError(f"samples must be at least 1, got {i.samples}")
         for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
@@ -370,7 +372,7 @@ class SceneDescription:
                        for d in meta["materials"]],
             lights=lights, camera=Camera(**cam),
             world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
-            film=Film(**film), integrator=Integrator(**meta["integrator"]),
+            film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
             warnings=meta.get("warnings", []))
 
 
@@ -382,3 +384,11 @@ def _light_meta(li: Light) -> dict:
     d = _plain(dataclasses.asdict(li))
     d["strength"] = [float(x) for x in d["strength"]]
     return {k: (float(v) if isinstance(v, np.floating) else v) for k, v in d.items()}
+
+
+def _integrator_meta(d: dict) -> dict:
+    """Integrator settings of a saved scene; files saved before 0.2 call the name "method"."""
+    d = dict(d)
+    if "method" in d:
+        d["name"] = d.pop("method")
+    return d

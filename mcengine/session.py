@@ -29,21 +29,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import classic as C
-from . import features as features_mod
-from . import integrator as K
-from .bsdf import M_EMISSIVE, M_W_GLASS, M_W_MIRROR, M_W_REFRACT, pack_materials
-from .camera import pack_camera
+from .adaptive import Adaptive
 from .film import Film
-from .intersect import Accel
-from .lights import (L_PMF, light_distribution, pack_lights)
-from .sampling import filter_table
+from .integrators import get as integrator_info
+from .kernels import classic, path
+from .kernels.intersect import Accel
+from .kernels.materials import M_W_GLASS, M_W_MIRROR, M_W_REFRACT
+from .kernels.state import (ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_NONFINITE, ST_SELF_HITS,
+                            ST_SHADOW_RAYS, ST_SIZE, alloc_path_state, alloc_shadow_queue)
+from .packing import pack_scene
 from .scene import SceneDescription, SceneError
 
 DEFAULT_BATCH = 1 << 17       # paths per chunk: ~50 MB of buffers per worker
 PASS_PATHS = 1 << 21          # a pass grows until it holds about this many paths
 MIN_CHUNK_PATHS = 1 << 12     # below this, per-call overhead dominates
-LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
 
 @dataclass
@@ -137,10 +136,10 @@ class _Buffers:
 
     def __init__(self, batch, classic):
         self.key = (batch, classic)
-        self.state = K.alloc_path_state(batch)
-        self.shadow = K.alloc_shadow_queue(batch)
+        self.state = alloc_path_state(batch)
+        self.shadow = alloc_shadow_queue(batch)
         if classic:   # a second generation of rays and per-camera-sample sums
-            self.next_state = K.alloc_path_state(batch)
+            self.next_state = alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
             self.root_pixel = np.zeros(batch, np.int32)
 
@@ -171,99 +170,10 @@ class _Worker:
 
     def __init__(self, buffers, accel):
         self.buffers = buffers
-        self.stats = np.zeros(K.ST_SIZE, np.int64)
+        self.stats = np.zeros(ST_SIZE, np.int64)
         self.embree_clock = [0.0]
         self.busy = 0.0
         self.accel = _TimedAccel(accel, self.embree_clock)
-
-
-def build_scene_data(scene: SceneDescription):
-    """Pack a scene description into kernel arrays; returns (SceneData, cfg, fcfg, Features)."""
-    g = scene.geometry
-    verts = g.vertices.astype(np.float64)
-    tris = np.ascontiguousarray(g.triangles, np.int32)
-    if len(tris):
-        p = verts[tris]
-        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        length = np.linalg.norm(cross, axis=1)
-        tri_area = 0.5 * length
-        tri_normal = cross / np.where(length > 0, length, 1.0)[:, None]
-        lo, hi = verts.min(axis=0), verts.max(axis=0)
-    else:
-        tri_area = np.zeros(0)
-        tri_normal = np.zeros((0, 3))
-        lo = hi = np.zeros(3)
-    lamp_pos = [np.asarray(li.matrix_world, float)[:3, 3] for li in scene.lights if li.type != "SUN"]
-    if lamp_pos:
-        lo = np.minimum(lo, np.min(lamp_pos, axis=0))
-        hi = np.maximum(hi, np.max(lamp_pos, axis=0))
-    scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
-
-    materials = pack_materials(scene.materials)
-    mat_index = np.ascontiguousarray(g.material_index, np.int32)
-    emissive = (materials[mat_index, M_EMISSIVE] > 0.0) & (tri_area > 0.0) if len(tris) else np.zeros(0, bool)
-    emit_tri = np.flatnonzero(emissive).astype(np.int32)
-    emit_power = materials[mat_index[emit_tri], 3:6].mean(axis=1) * math.pi * tri_area[emit_tri]
-    tri_light = np.full(len(tris), -1, np.int32)
-    tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
-
-    lamps, lamp_power = pack_lights(scene.lights, scene_radius)
-    cdf, lamp_pmf, emit_pmf = light_distribution(lamp_power, emit_power)
-    emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
-    if emit_cdf[-1] > 0:
-        emit_cdf /= emit_cdf[-1]
-    # The emissive triangles as one light for per-point picking: its centre,
-    # its radius squared (the distance floor) and an irradiance scale.
-    emit_group = np.zeros(5)
-    if len(emit_tri):
-        corners = verts[tris[emit_tri]].reshape(-1, 3)
-        lo_e, hi_e = corners.min(axis=0), corners.max(axis=0)
-        emit_group[:3] = 0.5 * (lo_e + hi_e)
-        emit_group[3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
-        emit_group[4] = emit_power.sum() / math.pi
-    if len(lamps):
-        lamps[:, L_PMF] = lamp_pmf
-    feats = features_mod.detect(scene, len(emit_tri), lamp_power)
-
-    film = scene.film
-    x0, y0, x1, y1 = film.window
-    world = np.asarray(scene.world.color, np.float64).reshape(3)
-    sc = K.SceneData(
-        verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
-        mat_index=mat_index, materials=materials,
-        lamps=lamps,
-        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf,
-        emit_group=emit_group, tri_light=tri_light,
-        tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
-        filter_table=filter_table(film.filter_type, film.filter_width))
-
-    it = scene.integrator
-    cfg = np.zeros(K.CFG_SIZE, np.int64)
-    cfg[K.CFG_MAX_BOUNCE] = it.max_bounces
-    cfg[K.CFG_MAX_DIFFUSE] = it.diffuse_bounces
-    cfg[K.CFG_MAX_GLOSSY] = it.glossy_bounces
-    cfg[K.CFG_MAX_TRANSMISSION] = it.transmission_bounces
-    cfg[K.CFG_MAX_TRANSPARENT] = it.transparent_max_bounces
-    cfg[K.CFG_MIN_LIGHT_BOUNCES] = it.min_light_bounces
-    cfg[K.CFG_SEED] = it.seed & 0x7FFFFFFFFFFFFFFF
-    cfg[K.CFG_FILM_TRANSPARENT] = 1 if film.transparent else 0
-    cfg[K.CFG_WORLD_CAMERA] = 1 if scene.world.visible_camera else 0
-    cfg[K.CFG_LAMPS_HIT] = 1 if feats.lamps_hit else 0
-    cfg[K.CFG_REGION_X], cfg[K.CFG_REGION_Y], cfg[K.CFG_REGION_W] = x0, y0, x1 - x0
-    cfg[K.CFG_FULL_W] = film.width
-    cfg[K.CFG_LIGHTS] = 1 if feats.nee else 0
-    cfg[K.CFG_WORLD] = 1 if feats.world else 0
-    fcfg = np.zeros(K.FCFG_SIZE)
-    # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.
-    fcfg[K.FCFG_CLAMP_DIRECT] = 3.0 * it.clamp_direct if it.clamp_direct > 0 else math.inf
-    fcfg[K.FCFG_CLAMP_INDIRECT] = 3.0 * it.clamp_indirect if it.clamp_indirect > 0 else math.inf
-    emit_share = float(emit_pmf.sum())
-    fcfg[K.FCFG_EMIT_SCALE] = 1.0 / emit_share if emit_share > 0 else 0.0
-    # Per-point light picking pays for itself when there is a choice to make and
-    # the scan over lamps stays short.
-    n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
-    cfg[K.CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
-    return sc, cfg, fcfg, feats
 
 
 def default_threads() -> int:
@@ -280,8 +190,8 @@ class RenderSession:
         self.batch_size = int(batch_size or DEFAULT_BATCH)
         it = scene.integrator
         self.stats = RenderStats(samples_target=it.samples)
-        self.sc, self.cfg, self.fcfg, self.features = build_scene_data(scene)
-        self.method = it.method
+        self.sc, self.cfg, self.fcfg, self.features = pack_scene(scene)
+        self.integrator = integrator_info(it.name)
         self._classic_setup()
         x0, y0, x1, y1 = scene.film.window
         self.film = Film(x1 - x0, y1 - y0)
@@ -317,10 +227,6 @@ class RenderSession:
     def sample_counts(self) -> np.ndarray:
         """(h, w) int: samples taken in each pixel (they differ with adaptive sampling)."""
         return self.film.count.reshape(self.film.height, self.film.width).copy()
-
-    def stop(self) -> None:
-        """Ask a running ``run`` to stop after the chunks in flight."""
-        self._stop.set()
 
     def run(self, on_pass=None, should_stop=None) -> "RenderSession":
         """Render the remaining samples; ``on_pass(self)`` after each pass."""
@@ -373,29 +279,31 @@ class RenderSession:
         return sum(a.nbytes for a in self.film.arrays) + self._buffer_bytes
 
     # -- internals -----------------------------------------------------------------------
+    @property
+    def _classic(self) -> bool:
+        return self.integrator.name != "path"
+
     def _classic_setup(self):
+        """Chunk size of the classic integrators: their widest ray generation must fit the batch."""
         it = self.scene.integrator
-        if self.method == "path":
+        if self.integrator.name == "path":
             self.roots_per_chunk = self.batch_size
             return
-        self.mode = {"raycast": C.MODE_RAYCAST, "whitted": C.MODE_WHITTED,
-                     "distribution": C.MODE_DISTRIBUTION}[self.method]
-        self.depth = 1 if self.method == "raycast" else int(it.depth)
+        self.code = classic.CODES[self.integrator.name]
+        self.depth = int(it.depth) if self.integrator.uses_depth else 1
         self.branching = int(it.branching)
         m = self.sc.materials
         # Whitted spawns one ray per specular lobe and two for glass.
         whitted_children = int(((m[:, M_W_MIRROR] > 0) + 2 * (m[:, M_W_GLASS] > 0)
                                 + (m[:, M_W_REFRACT] > 0)).max(initial=1))
-        b = self.branching if self.method == "distribution" else max(whitted_children, 1)
+        b = self.branching if self.integrator.uses_branching else max(whitted_children, 1)
         widest = b ** (self.depth - 1)
         if widest > self.batch_size:
             raise SceneError(
-                f"{self.method}: {b}^{self.depth - 1} = {widest} rays in the last ray level "
-                f"per camera sample exceed the batch of {self.batch_size}; lower the depth"
-                + (" or the branching" if self.method == "distribution" else ""))
+                f"{self.integrator.name}: {b}^{self.depth - 1} = {widest} rays in the last ray "
+                f"level per camera sample exceed the batch of {self.batch_size}; lower the depth"
+                + (" or the branching" if self.integrator.uses_branching else ""))
         self.roots_per_chunk = max(1, self.batch_size // widest)
-        total = float(self.sc.emit_pmf.sum())
-        self.emit_scale = 1.0 / total if total > 0 else 0.0
 
     def _stopping(self, should_stop, t_start, time_limit) -> bool:
         if self._stop.is_set():
@@ -423,7 +331,7 @@ class RenderSession:
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(_Buffers.take(self.batch_size, self.method != "path"), self.accel)
+            w = _Worker(_Buffers.take(self.batch_size, self._classic), self.accel)
             self._workers.w = w
             self._buffer_bytes = max(self._buffer_bytes, self.threads * w.buffers.nbytes)
             with self._lock:
@@ -432,13 +340,13 @@ class RenderSession:
 
     def _trace_with(self, w, pixels, spp, film):
         b = w.buffers
-        if self.method == "path":
-            K.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
-                          film, w.stats)
+        if not self._classic:
+            path.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
+                             film, w.stats)
         else:
-            C.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
-                                  (b.state, b.next_state, b.shadow, b.acc, b.root_pixel), film,
-                                  w.stats, self.mode, self.depth, self.branching, self.emit_scale)
+            classic.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
+                                        (b.state, b.next_state, b.shadow, b.acc, b.root_pixel),
+                                        film, w.stats, self.code, self.depth, self.branching)
 
     def _trace(self, pixels, spp):
         if self._stop.is_set():
@@ -450,24 +358,23 @@ class RenderSession:
 
     def _warm_up(self):
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
-        classic = self.method != "path"
-        size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if classic else 64
-        self._trace_with(_Worker(_Buffers(size, classic), self.accel), np.zeros(1, np.int32), 1,
-                         Film(1, 1).arrays)
+        size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self._classic else 64
+        self._trace_with(_Worker(_Buffers(size, self._classic), self.accel),
+                         np.zeros(1, np.int32), 1, Film(1, 1).arrays)
 
     def _update_stats(self, t_start):
         s = self.stats
         s.time_render = time.perf_counter() - t_start
-        totals = np.zeros(K.ST_SIZE, np.int64)
+        totals = np.zeros(ST_SIZE, np.int64)
         with self._lock:
             workers = list(self._all_workers)
         for w in workers:
             totals += w.stats
-        s.camera_rays = int(totals[K.ST_CAMERA_RAYS])
-        s.bounce_rays = int(totals[K.ST_BOUNCE_RAYS])
-        s.shadow_rays = int(totals[K.ST_SHADOW_RAYS])
-        s.self_hits = int(totals[K.ST_SELF_HITS])
-        s.nonfinite = int(totals[K.ST_NONFINITE])
+        s.camera_rays = int(totals[ST_CAMERA_RAYS])
+        s.bounce_rays = int(totals[ST_BOUNCE_RAYS])
+        s.shadow_rays = int(totals[ST_SHADOW_RAYS])
+        s.self_hits = int(totals[ST_SELF_HITS])
+        s.nonfinite = int(totals[ST_NONFINITE])
         s.paths = s.camera_rays
         s.time_embree = sum(w.embree_clock[0] for w in workers)
         s.time_workers = sum(w.busy for w in workers)
@@ -478,73 +385,3 @@ class RenderSession:
         else:
             remaining = (s.samples_target - s.samples_done) * self.film.count.size
         s.eta_seconds = remaining / s.paths_per_second if s.paths_per_second > 0 else float("nan")
-
-
-class Adaptive:
-    """Adaptive sampling: pixels stop once their estimated noise is below a threshold.
-
-    A pixel's error is the standard error of its mean, summed over RGB in
-    quadrature, relative to its brightness the way Cycles normalises it
-    (kernel/film/adaptive_sampling.h): divided by sqrt(sum RGB) below 1,
-    where the eye is more sensitive to noise, and by sum RGB above 1.  Every
-    pixel takes at least ``min_samples``; convergence is checked every
-    ``CHECK_EVERY`` samples after that, and the unconverged pixels' 3x3
-    neighbours keep sampling too, as in Cycles, so a feature that the noise
-    estimate missed in one pixel is not left half-sampled.
-    """
-
-    CHECK_EVERY = 16
-
-    def __init__(self, threshold, min_samples):
-        self.threshold = float(threshold)
-        self.min_samples = int(min_samples)
-
-    @staticmethod
-    def from_settings(it):
-        if not it.use_adaptive_sampling:
-            return None
-        threshold = it.adaptive_threshold if it.adaptive_threshold > 0 else max(0.001, 1.0 / it.samples)
-        min_samples = it.adaptive_min_samples
-        if min_samples <= 0:    # Cycles' automatic minimum
-            min_samples = max(4, int(math.ceil(16.0 / threshold ** 0.3)))
-        return Adaptive(threshold, min(min_samples, it.samples))
-
-    def next_check(self, done):
-        if done < self.min_samples:
-            return self.min_samples
-        return done + self.CHECK_EVERY
-
-    def error(self, film):
-        """(n,) relative error of every film pixel (inf below 2 samples)."""
-        n = film.count.astype(np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            mean = film.sum[:, :3] / n[:, None]
-            var = (film.sum_sq - n[:, None] * mean * mean) / (n[:, None] - 1.0) / n[:, None]
-            se = np.sqrt(np.maximum(var, 0.0).sum(axis=1))
-            total = mean.sum(axis=1)
-            scale = np.where(total < 1.0, np.sqrt(np.maximum(total, 0.0)), total)
-            err = se / (1e-4 + scale)
-        return np.where(n >= 2, err, np.inf)
-
-    def unconverged(self, film, done):
-        """Indices of the pixels that keep sampling after ``done`` samples."""
-        if done < self.min_samples:
-            return np.arange(film.count.size, dtype=np.int32)
-        open_ = (self.error(film) >= self.threshold).reshape(film.height, film.width)
-        grown = open_.copy()   # 3x3 dilation
-        grown[1:, :] |= open_[:-1, :]
-        grown[:-1, :] |= open_[1:, :]
-        g2 = grown.copy()
-        g2[:, 1:] |= grown[:, :-1]
-        g2[:, :-1] |= grown[:, 1:]
-        return np.flatnonzero(g2.ravel()).astype(np.int32)
-
-    def remaining_samples(self, film, active, max_samples):
-        """Estimated samples still to take: error falls as 1/sqrt(n)."""
-        if active.size == 0:
-            return 0
-        n = film.count[active].astype(np.float64)
-        err = self.error(film)[active]
-        needed = np.where(np.isfinite(err), n * (err / self.threshold) ** 2, max_samples)
-        needed = np.clip(np.maximum(needed, self.min_samples), 0, max_samples)
-        return float(np.maximum(needed - n, 0).sum())

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 from mcengine.scene import SceneDescription, SceneError
 
-__all__ = ["ExportError", "ExportContext", "ExportResult", "export", "scene_description"]
+__all__ = ["ExportError", "ExportContext", "ExportResult", "export"]
 
 
 class ExportError(SceneError):
@@ -67,27 +67,10 @@ class ExportContext:
 
 @dataclass
 class ExportResult:
-    """What :func:`export` produces: the scene plus a summary for the UI."""
+    """What :func:`export` produces: the scene and the features it ignored."""
 
     scene: SceneDescription
     ignored: list = field(default_factory=list)
-
-    def effects(self) -> str:
-        """One line naming what the scene uses, e.g. "Diffuse, Emission, 2 Point, World"."""
-        found = []
-        mats = self.scene.materials
-        used = set(self.scene.geometry.material_index.tolist())
-        if any(max(mats[i].base_color) > 0 for i in used):
-            found.append("Diffuse")
-        if any(max(mats[i].emission) > 0 for i in used):
-            found.append("Emission")
-        counts: dict[str, int] = {}
-        for light in self.scene.lights:
-            counts[light.type] = counts.get(light.type, 0) + 1
-        found += [f"{n} {t.title()}" for t, n in counts.items()]
-        if max(self.scene.world.color) > 0:
-            found.append("World")
-        return ", ".join(found) if found else "nothing visible"
 
 
 def export(depsgraph) -> ExportResult:
@@ -130,11 +113,6 @@ def export(depsgraph) -> ExportResult:
     )
     desc.warnings = list(ctx.warnings)
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
-
-
-def scene_description(depsgraph) -> SceneDescription:
-    """Shortcut for ``export(depsgraph).scene``."""
-    return export(depsgraph).scene
 
 
 def _instance_name(inst) -> str:

@@ -8,6 +8,7 @@ are used and one warning says so.
 from __future__ import annotations
 
 import numpy as np
+from mcengine import integrators
 from mcengine.scene import Integrator
 
 __all__ = ["unit_scale", "cycles_settings", "export_integrator", "hash_uint2"]
@@ -102,5 +103,5 @@ def mcengine_settings(scene) -> dict:
     own = getattr(scene, "mcengine", None)
     if own is None:
         return {}
-    return {"method": own.integrator.lower(), "depth": int(own.depth),
+    return {"name": integrators.from_enum(own.integrator).name, "depth": int(own.depth),
             "branching": int(own.branching)}

@@ -11,6 +11,8 @@ import bpy
 import numpy as np
 import OpenEXR
 
+from mcengine.packing import pack_scene
+
 ROOT = Path(__file__).resolve().parents[2]
 ADDON_DIR = ROOT / "addon"
 PACKAGE = "mcengine_blender"
@@ -62,6 +64,7 @@ class GradientSession:
         self._image = np.zeros_like(self.target)
         self.samples_done = 0
         self.stats = SimpleNamespace(rays_per_second=2.5e6, eta_seconds=3.0)
+        self.features = pack_scene(desc).features
         self.pass_images = []
 
     def run(self, on_pass=None, should_stop=None):

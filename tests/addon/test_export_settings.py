@@ -27,7 +27,7 @@ def test_adaptive_sampling_and_integrator_choice(scene, fake_session):
     scene.mcengine.integrator, scene.mcengine.depth, scene.mcengine.branching = "DISTRIBUTION", 3, 6
     i = export_scene(fake_session).integrator
     assert (i.use_adaptive_sampling, i.adaptive_threshold, i.adaptive_min_samples) == (True, pytest.approx(0.03), 12)
-    assert (i.method, i.depth, i.branching) == ("distribution", 3, 6)
+    assert (i.name, i.depth, i.branching) == ("distribution", 3, 6)
 
 
 def test_view_layer_samples_override(scene, fake_session):

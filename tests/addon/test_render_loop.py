@@ -84,9 +84,10 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
     panel_lines = _panel_text(addon, scene)
     assert panel_lines == ["Not rendered yet"]
     bpy.ops.render.render()
-    assert scene.mcengine.last_effects == "Diffuse, Emission, 1 Sun"
+    line = "Lights: 1 sun, 1 emissive triangle; surfaces: diffuse"
+    assert scene.mcengine.last_effects == line
     assert scene.mcengine.last_ignored == "specular, denoising"
-    assert _panel_text(addon, scene) == ["Effects: Diffuse, Emission, 1 Sun",
+    assert _panel_text(addon, scene) == [line,
                                          "Ignored: specular, denoising"]
 
 

@@ -9,7 +9,7 @@ height gives a half-height of 2.4 m.
 import numpy as np
 import pytest
 
-from mcengine.camera import camera_rays
+from mcengine.kernels.camera import camera_rays
 from mcengine.scene import Camera, Film
 
 from .scenes import translation

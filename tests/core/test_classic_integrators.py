@@ -31,7 +31,7 @@ def _rays_per_sample(session):
 @pytest.mark.parametrize("b,r", [(3, 4), (2, 5), (5, 2)])
 def test_distribution_ray_count_is_the_sum_of_b_to_the_k(b, r):
     scene = inside_sphere_scene(albedo=0.5, samples=2, res=8)   # flat facets: no ray is lost
-    scene.integrator.method = "distribution"
+    scene.integrator.name = "distribution"
     scene.integrator.branching, scene.integrator.depth = b, r
     s = RenderSession(scene).run()
     assert _rays_per_sample(s) == sum(b ** k for k in range(r))
@@ -47,7 +47,7 @@ def test_whitted_ray_count_is_two_to_the_r_minus_one(r):
         camera=Camera(matrix_world=np.eye(4), lens=20.0, clip_start=1e-3),
         world=World(color=(1.0, 1.0, 1.0)),
         film=Film(width=8, height=8),
-        integrator=Integrator(method="whitted", depth=r, samples=2))
+        integrator=Integrator(name="whitted", depth=r, samples=2))
     s = RenderSession(scene).run()
     assert _rays_per_sample(s) == 2 ** r - 1
 
@@ -57,18 +57,18 @@ def test_raycast_casts_one_ray_and_one_shadow_ray_per_light():
           for x in (-1.0, 1.0)]
     scene = plane_scene(li[0], samples=4)
     scene.lights = li
-    scene.integrator.method = "raycast"
+    scene.integrator.name = "raycast"
     s = RenderSession(scene).run()
     assert _rays_per_sample(s) == 1
     assert s.stats.shadow_rays == 2 * s.stats.camera_rays
 
 
-@pytest.mark.parametrize("method", ["raycast", "whitted", "distribution"])
-def test_direct_light_is_exact_for_every_method(method):
+@pytest.mark.parametrize("name", ["raycast", "whitted", "distribution"])
+def test_direct_light_is_exact_for_every_integrator(name):
     P, H = 1000.0, 2.0
     li = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P, P, P))
     scene = plane_scene(li)
-    scene.integrator.method = method
+    scene.integrator.name = name
     scene.integrator.depth = 2
     assert_mean(render(scene), P / (4 * math.pi * H * H) / math.pi)
 
@@ -78,7 +78,7 @@ def test_distribution_equals_path_tracing_with_r_minus_one_bounces(b, r):
     # Inside an emissive sphere of albedo 1/2: path tracing with N bounces
     # gives sum_{k<=N+1} 1/2^k, so depth r gives sum_{k<=r} 1/2^k.
     scene = inside_sphere_scene(albedo=0.5, emission=1.0, samples=32)
-    scene.integrator.method = "distribution"
+    scene.integrator.name = "distribution"
     scene.integrator.branching, scene.integrator.depth = b, r
     assert_mean(render(scene), sum(0.5 ** k for k in range(r + 1)))
 
@@ -93,9 +93,9 @@ def test_raycast_misses_indirect_light_and_whitted_finds_mirrors():
         camera=Camera(matrix_world=translation(0, 0, 4), type="ORTHO", ortho_scale=1.0),
         world=World(color=(1.0, 1.0, 1.0)),
         film=Film(width=8, height=8, filter_type="BOX", filter_width=1.0),
-        integrator=Integrator(method="raycast", samples=4))
+        integrator=Integrator(name="raycast", samples=4))
     assert np.all(render(scene).image()[..., :3] == 0.0)
-    scene.integrator.method, scene.integrator.depth = "whitted", 2
+    scene.integrator.name, scene.integrator.depth = "whitted", 2
     assert np.allclose(render(scene).image()[..., :3], 0.7, atol=1e-5)
 
 
@@ -107,7 +107,7 @@ def test_whitted_glass_sphere_conserves_energy_under_a_uniform_sky():
         camera=Camera(matrix_world=translation(0, 0, 4), type="ORTHO", ortho_scale=0.8),
         world=World(color=(1.0, 1.0, 1.0)),
         film=Film(width=8, height=8, filter_type="BOX", filter_width=1.0),
-        integrator=Integrator(method="whitted", depth=10, samples=2))
+        integrator=Integrator(name="whitted", depth=10, samples=2))
     img = render(scene).image()[..., 0]
     # Fresnel splits every ray into reflected and refracted parts whose weights
     # sum to 1; only chains longer than 10 levels (F^9 < 1e-12 here) are lost.
@@ -116,7 +116,7 @@ def test_whitted_glass_sphere_conserves_energy_under_a_uniform_sky():
 
 def test_too_wide_a_ray_tree_is_a_clear_error():
     scene = inside_sphere_scene(samples=1)
-    scene.integrator.method = "distribution"
-    scene.integrator.branching, scene.integrator.depth = 100, 5
+    scene.integrator.name = "distribution"
+    scene.integrator.branching, scene.integrator.depth = 64, 5
     with pytest.raises(SceneError, match="exceed the batch"):
         RenderSession(scene)

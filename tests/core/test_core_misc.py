@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from mcengine.imageio import ImageError, read_exr, write_exr, write_png
-from mcengine.sampling import disk_concentric, disk_polar, filter_offset, filter_table
+from mcengine.kernels.sampling import disk_concentric, disk_polar, filter_offset, filter_table
 from mcengine.scene import SceneDescription, SceneError
 
 from .expect import render

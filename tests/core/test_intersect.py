@@ -1,7 +1,7 @@
 """Embree closest hits against a brute-force float64 triangle test."""
 import numpy as np
 
-from mcengine.intersect import Accel, intersect_triangle
+from mcengine.kernels.intersect import Accel, intersect_triangle
 
 
 def brute_force(o, d, tris):

@@ -247,7 +247,7 @@ def test_lights_picked_per_point_add_up_to_the_sum_of_each_light():
     E = (P1 / (4 * math.pi * H * H) + P2 / (4 * math.pi * d2) * (1.0 / math.sqrt(d2))
          + _area_irradiance(1.0, 1.0, False, Pa))
     s = render(scene)
-    from mcengine.integrator import CFG_LOCAL_LIGHTS
+    from mcengine.kernels.state import CFG_LOCAL_LIGHTS
     assert s.cfg[CFG_LOCAL_LIGHTS] == 1      # this scene picks lights per point
     assert_mean(s, lambert(E), max_rel_se=0.003)
 

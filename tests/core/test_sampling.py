@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 from scipy import stats
 
-from mcengine.sampling import path_key, rand
+from mcengine.kernels.sampling import path_key, rand
 
 
 @njit(cache=False)

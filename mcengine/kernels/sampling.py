@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from .jit import device
+from ..jit import device
 
 # -- dimensions ----------------------------------------------------------------
 # Camera dimensions come first, then a block of DIMS_PER_BOUNCE numbers for
@@ -105,19 +105,6 @@ def cosine_hemisphere(u1, u2):
     x, y = disk_concentric(u1, u2)
     z = math.sqrt(max(0.0, 1.0 - x * x - y * y))
     return x, y, z
-
-
-@device
-def cosine_hemisphere_pdf(cos_theta):
-    return max(cos_theta, 0.0) / math.pi
-
-
-@device
-def uniform_sphere(u1, u2):
-    z = 1.0 - 2.0 * u1
-    r = math.sqrt(max(0.0, 1.0 - z * z))
-    phi = 2.0 * math.pi * u2
-    return r * math.cos(phi), r * math.sin(phi), z
 
 
 @device

@@ -14,6 +14,9 @@ The camera looks along its local -Z with +Y up.  The view plane at distance 1
 
 Raster coordinates: x to the right, y downwards, (0, 0) the top-left corner of
 the full frame; pixel (i, j) covers [i, i+1) x [j, j+1).
+
+``generate_camera_rays`` starts the paths of a chunk: a raster position per
+sample from the pixel filter, its camera ray, and a fresh path state.
 """
 from __future__ import annotations
 
@@ -21,7 +24,11 @@ import math
 
 import numpy as np
 
-from .jit import device
+from ..jit import device, kernel
+from .intersect import T_INFINITE
+from .sampling import DIM_FILTER_X, DIM_FILTER_Y, filter_offset, path_key, rand
+from .state import (CFG_FILM_TRANSPARENT, CFG_FULL_W, CFG_REGION_W, CFG_REGION_X, CFG_REGION_Y,
+                    CFG_SEED, PF_CAMERA, PF_MIS_SKIP, PF_TRANSPARENT_BG)
 
 CAM_PERSP = 0
 CAM_ORTHO = 1
@@ -121,6 +128,56 @@ def camera_ray(cam, rx, ry):
     t0 = cam[C_CLIP_START] / inv_len
     return (cam[C_POS] + t0 * dx, cam[C_POS + 1] + t0 * dy, cam[C_POS + 2] + t0 * dz,
             dx, dy, dz, (cam[C_CLIP_END] - cam[C_CLIP_START]) / inv_len)
+
+
+@kernel
+def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
+    """Start ``spp`` paths for each film pixel in ``pixels``; returns the path count.
+
+    The sample index of a path is the pixel's count of finished samples
+    (``sample_base``) plus its rank here, so every sample of a pixel has its
+    own random numbers whatever the pass schedule.
+    """
+    n = 0
+    region_x, region_y, region_w = cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W]
+    transparent_bg = PF_TRANSPARENT_BG if cfg[CFG_FILM_TRANSPARENT] else 0
+    for pi in range(pixels.shape[0]):
+        pix = pixels[pi]
+        x = region_x + pix % region_w
+        y = region_y + pix // region_w
+        global_pixel = y * cfg[CFG_FULL_W] + x
+        for j in range(spp):
+            sample = sample_base[pix] + j
+            key = path_key(cfg[CFG_SEED], global_pixel, sample)
+            # Cycles takes the first sample of every pixel at the pixel centre.
+            if sample == 0:
+                fx, fy = 0.5, 0.5
+            else:
+                fx = filter_offset(sc.filter_table, rand(key, DIM_FILTER_X))
+                fy = filter_offset(sc.filter_table, rand(key, DIM_FILTER_Y))
+            ox, oy, oz, dx, dy, dz, tmax = camera_ray(sc.camera, x + fx, y + fy)
+            st.key[n] = key
+            st.pixel[n] = pix
+            st.ray_o[n, 0], st.ray_o[n, 1], st.ray_o[n, 2] = ox, oy, oz
+            st.ray_d[n, 0], st.ray_d[n, 1], st.ray_d[n, 2] = dx, dy, dz
+            st.ray_tmax[n] = tmax
+            st.beta[n, 0], st.beta[n, 1], st.beta[n, 2] = 1.0, 1.0, 1.0
+            st.radiance[n, 0], st.radiance[n, 1], st.radiance[n, 2] = 0.0, 0.0, 0.0
+            st.transparency[n] = 0.0
+            st.bounce[n] = 0
+            st.diffuse[n] = 0
+            st.glossy[n] = 0
+            st.transmission[n] = 0
+            st.transparent[n] = 0
+            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | transparent_bg
+            st.mis_pdf[n] = 0.0
+            st.self_prim[n] = -1
+            st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz
+            st.d32[n, 0], st.d32[n, 1], st.d32[n, 2] = dx, dy, dz
+            st.t32[n] = min(tmax, T_INFINITE)
+            n += 1
+    return n
+
 
 
 def camera_rays(scene_camera, film, rx, ry):

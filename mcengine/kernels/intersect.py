@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from .jit import device
+from ..jit import device
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about
 # 32 float32 ulps, above the rounding of the origin to float32 (half an ulp

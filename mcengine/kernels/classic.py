@@ -32,51 +32,36 @@ import math
 
 import numpy as np
 
-from .bsdf import (LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT, M_EMISSION, M_EMISSIVE, M_GLASS,
-                   M_IOR, M_MIRROR, M_REFRACT, M_W_GLASS, M_W_MIRROR, M_W_REFRACT, bsdf_eval,
-                   bsdf_has_lobes, bsdf_sample, fresnel_dielectric)
-from .integrator import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, CFG_WORLD,
-                         CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT, PF_CAMERA,
-                         PMF_EVERY,
-                         PF_TRANSPARENT_BG, ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS,
-                         ST_SHADOW_RAYS, add_light, clamp_light, emission_weight, generate_camera_rays,
-                         hit_distance, lamps_on_segment, local_frame, next_path_flags,
-                         past_self_hit, power_heuristic, push_shadow, sample_light, set_ray,
-                         sun_light, surface_geometry)
+from ..jit import device, kernel
+from .camera import generate_camera_rays
+from .closures import LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT
+from .closures.fresnel import fresnel_dielectric
 from .intersect import offset_origin
-from .jit import device, kernel
-from .lights import L_PMF, pick_light
+from .light_sampling import PMF_EVERY, pick_light
+from .lights import L_PMF
+from .materials import (M_EMISSIVE, M_GLASS, M_IOR, M_MIRROR, M_REFRACT, M_W_GLASS, M_W_MIRROR,
+                        M_W_REFRACT, bsdf_has_lobes)
 from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_LIGHT_PICK, DIM_LIGHT_U,
                        DIM_LIGHT_V, mix64, rand)
+from .shading import (direct_light, light_from_background, light_from_emitter, light_from_lamps,
+                      next_path_flags, sample_direction, set_ray, to_world)
+from .state import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, FCFG_EMIT_SCALE,
+                    ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS, ST_SHADOW_RAYS)
+from .surface import hit_distance, local_frame, past_self_hit, surface_point
 
-METHODS = ("path", "raycast", "whitted", "distribution")
-MODE_RAYCAST = 1
-MODE_WHITTED = 2
-MODE_DISTRIBUTION = 3
+# Integer codes of the classic integrators in the kernels (names: mcengine.integrators).
+CODE_RAYCAST = 1
+CODE_WHITTED = 2
+CODE_DISTRIBUTION = 3
+CODES = {"raycast": CODE_RAYCAST, "whitted": CODE_WHITTED, "distribution": CODE_DISTRIBUTION}
 _K_CHILD = np.uint64(0xA24BAED4963EE407)
 _K_LIGHT = np.uint64(0x9FB21C651E98DF25)
 
 
-def rays_per_sample_bound(method: str, depth: int, branching: int) -> int:
-    """Most closest-hit rays one camera sample can cast (the lecture's formulas)."""
-    if method == "raycast":
-        return 1
-    b = 2 if method == "whitted" else branching
-    return sum(b ** k for k in range(depth))
-
-
-def widest_generation(method: str, depth: int, branching: int) -> int:
-    """Most rays of one generation per camera sample."""
-    if method == "raycast":
-        return 1
-    b = 2 if method == "whitted" else branching
-    return b ** (depth - 1)
-
-
 @device
-def _push_child(nx, n_next, st, i, key, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
-                br, bg, bb, flags, mis_pdf, p):
-    """Write the next-generation node ``n_next`` from node i; returns n_next + 1."""
+def _push_child(nx, n_next, st, i, key, sp, wix, wiy, wiz, br, bg, bb, flags, mis_pdf, p):
+    """Write the next-generation node ``n_next`` from node i, its ray leaving
+    the shading point ``sp`` along wi; returns n_next + 1."""
     nx.key[n_next] = key
     nx.pixel[n_next] = st.pixel[i]
     nx.root[n_next] = st.root[i]
@@ -85,9 +70,9 @@ def _push_child(nx, n_next, st, i, key, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz
     nx.transparent[n_next] = st.transparent[i]
     nx.flags[n_next] = flags
     nx.mis_pdf[n_next] = mis_pdf
-    nx.mis_p[n_next, 0], nx.mis_p[n_next, 1], nx.mis_p[n_next, 2] = hx, hy, hz
+    nx.mis_p[n_next, 0], nx.mis_p[n_next, 1], nx.mis_p[n_next, 2] = sp.hx, sp.hy, sp.hz
     nx.self_prim[n_next] = p
-    ox, oy, oz = offset_origin(hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz)
+    ox, oy, oz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
     set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
             ox, oy, oz, wix, wiy, wiz, math.inf)
     return n_next + 1
@@ -117,7 +102,7 @@ def _copy_node(nx, n_next, st, i, advance):
 
 @kernel
 def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stats,
-                  mode, depth, branching, emit_scale):
+                  code, depth, branching):
     """Shade nodes [start, end); children go to ``nx`` from ``n_next`` on.
 
     Returns ``(n_shadow, n_next)``.  Light is added to the per-camera-sample
@@ -138,50 +123,40 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
             continue
         root = st.root[i]
         flags = st.flags[i]
+        mis_pdf = st.mis_pdf[i]
+        mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
         bounce = st.bounce[i]
         br, bg, bb = st.beta[i, 0], st.beta[i, 1], st.beta[i, 2]
         t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
-        arrival_direct = bounce <= 1
+        direct = bounce <= 1
 
         if lamps_hit:
-            lr, lg, lb, passed = lamps_on_segment(
-                sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, st.mis_pdf[i], PMF_EVERY,
-                st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2], 0.0,
-                cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
+            passed = light_from_lamps(sc, cfg, fcfg, stats, acc, root, st.beta, i,
+                                      ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, PMF_EVERY,
+                                      mpx, mpy, mpz, 0.0, st.transparent[i], direct)
             if passed:
-                add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
-                if st.transparent[i] + passed >= cfg[CFG_MAX_TRANSPARENT]:
+                st.transparent[i] += passed
+                if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
                     continue
         if p < 0:
-            if flags & PF_TRANSPARENT_BG:
+            if light_from_background(sc, cfg, fcfg, stats, acc, root, st.beta, i, dx, dy, dz,
+                                     flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct):
                 acc[root, 3] = 1.0
-            elif cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
-                add_light(acc, root, br * sc.world[0], bg * sc.world[1], bb * sc.world[2],
-                            arrival_direct, fcfg, stats)
-            if n_lamps:
-                lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, st.mis_pdf[i], PMF_EVERY,
-                                       0.0, 0.0, 0.0, 0.0)
-                if lr + lg + lb > 0.0:
-                    add_light(acc, root, br * lr, bg * lg, bb * lb, arrival_direct, fcfg, stats)
             continue
         if sc.tri_area[p] <= 0.0:
             continue
-        hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing = surface_geometry(
-            sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+        sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
         if sc.materials[m, M_EMISSIVE] > 0.0:
-            w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o_geo, flags,
-                                st.mis_pdf[i], emit_scale)
-            add_light(acc, root, br * sc.materials[m, M_EMISSION] * w,
-                        bg * sc.materials[m, M_EMISSION + 1] * w,
-                        bb * sc.materials[m, M_EMISSION + 2] * w, arrival_direct, fcfg, stats)
+            light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, m, p, t_hit, sp.cos_o,
+                               flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct)
         if not bsdf_has_lobes(sc.materials, m):
             continue
         key = st.key[i]
-        tx, ty, tz, bx, by, bz, wox, woy, woz = local_frame(nsx, nsy, nsz, dx, dy, dz)
+        fr = local_frame(sp.nsx, sp.nsy, sp.nsz, dx, dy, dz)
         spawn = bounce + 2 <= depth          # the children's level is bounce + 2
         # Light samples share MIS with the BSDF rays only if BSDF rays follow.
-        nee_mis = mode == MODE_DISTRIBUTION and spawn
+        nee_mis = code == CODE_DISTRIBUTION and spawn
 
         # -- direct light from every light ------------------------------------------
         if cfg[CFG_LIGHTS]:
@@ -195,62 +170,33 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 else:
                     j = pick_light(sc.emit_cdf, rand(key, DIM_LIGHT_PICK))
                     idx = n_lamps + j
-                    pmf = sc.emit_pmf[j] * emit_scale
+                    pmf = sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
-                (wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis, cast_shadow, exclude,
-                 lnx, lny, lnz) = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris,
-                                               sc.tri_normal, sc.tri_area, sc.mat_index,
-                                               sc.materials, idx, pmf, hx, hy, hz, bounce,
-                                               rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V))
-                if lr + lg + lb <= 0.0 or wix * ngx + wiy * ngy + wiz * ngz <= 0.0:
-                    continue
-                fr, fg, fb, bsdf_pdf = bsdf_eval(
-                    sc.materials, m, wox, woy, woz, wix * tx + wiy * ty + wiz * tz,
-                    wix * bx + wiy * by + wiz * bz, wix * nsx + wiy * nsy + wiz * nsz, exclude)
-                w = power_heuristic(pdf_l, branching * bsdf_pdf) if (nee_mis and use_mis) else 1.0
-                cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
-                if cr + cg + cb <= 0.0:
-                    continue
-                limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
-                cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
-                if cast_shadow:
-                    n_shadow = push_shadow(sq.o32, sq.d32, sq.t32, sq.contrib, sq.path, n_shadow,
-                                           root, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz, dist,
-                                           lnx, lny, lnz, cr, cg, cb)
-                else:
-                    acc[root, 0] += cr
-                    acc[root, 1] += cg
-                    acc[root, 2] += cb
+                n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i, m,
+                                        sp, fr, idx, pmf, bounce, rand(lkey, DIM_LIGHT_U),
+                                        rand(lkey, DIM_LIGHT_V), nee_mis, float(branching))
         if not spawn:
             continue
 
         # -- secondary rays -------------------------------------------------------------
-        if mode == MODE_DISTRIBUTION:
+        if code == CODE_DISTRIBUTION:
+            k = 1.0 / branching
             for c in range(branching):
                 ckey = mix64(key ^ (np.uint64(c + 1) * _K_CHILD))
-                wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
-                    sc.materials, m, wox, woy, woz, backfacing, rand(ckey, DIM_BSDF_LOBE),
-                    rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V))
-                if (pdf <= 0.0 and not (label & LABEL_SINGULAR)) or wr + wg + wb <= 0.0:
+                ds = sample_direction(sc.materials, m, sp, fr, rand(ckey, DIM_BSDF_LOBE),
+                                      rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V))
+                if not ds.ok:
                     continue
-                wix = wlx * tx + wly * bx + wlz * nsx
-                wiy = wlx * ty + wly * by + wlz * nsy
-                wiz = wlx * tz + wly * bz + wlz * nsz
-                cos_i_geo = wix * ngx + wiy * ngy + wiz * ngz
-                if (label & LABEL_REFLECT and cos_i_geo <= 0.0) or \
-                        (label & LABEL_TRANSMIT and cos_i_geo >= 0.0):
-                    continue
-                k = 1.0 / branching
-                n_next = _push_child(nx, n_next, st, i, ckey, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
-                                     br * wr * k, bg * wg * k, bb * wb * k,
-                                     next_path_flags(flags, label), branching * pdf, p)
+                n_next = _push_child(nx, n_next, st, i, ckey, sp, ds.wix, ds.wiy, ds.wiz,
+                                     br * ds.wr * k, bg * ds.wg * k, bb * ds.wb * k,
+                                     next_path_flags(flags, ds.label), branching * ds.pdf, p)
         else:
             # Whitted: every perfect-specular lobe spawns its ray, weighted
             # deterministically (Fresnel splits glass into both).
             eta = sc.materials[m, M_IOR]
-            if backfacing:
+            if sp.backfacing:
                 eta = 1.0 / eta
-            f, cos_t = fresnel_dielectric(woz, eta)
+            f, cos_t = fresnel_dielectric(fr.woz, eta)
             for lobe in range(4):
                 if lobe == 0:
                     if sc.materials[m, M_W_MIRROR] <= 0.0:
@@ -268,19 +214,16 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 if scale <= 0.0:
                     continue
                 if refract:
-                    wlx, wly, wlz = -wox / eta, -woy / eta, -cos_t
+                    wlx, wly, wlz = -fr.wox / eta, -fr.woy / eta, -cos_t
                     label = LABEL_TRANSMIT | LABEL_SINGULAR
                 else:
-                    wlx, wly, wlz = -wox, -woy, woz
+                    wlx, wly, wlz = -fr.wox, -fr.woy, fr.woz
                     label = LABEL_REFLECT | LABEL_SINGULAR
-                wix = wlx * tx + wly * bx + wlz * nsx
-                wiy = wlx * ty + wly * by + wlz * nsy
-                wiz = wlx * tz + wly * bz + wlz * nsz
-                cos_i_geo = wix * ngx + wiy * ngy + wiz * ngz
-                if (refract and cos_i_geo >= 0.0) or (not refract and cos_i_geo <= 0.0):
+                ok, wix, wiy, wiz = to_world(sp, fr, wlx, wly, wlz, label)
+                if not ok:
                     continue
                 ckey = mix64(key ^ (np.uint64(lobe + 1) * _K_CHILD))
-                n_next = _push_child(nx, n_next, st, i, ckey, hx, hy, hz, ngx, ngy, ngz, wix, wiy, wiz,
+                n_next = _push_child(nx, n_next, st, i, ckey, sp, wix, wiy, wiz,
                                      br * sc.materials[m, col] * scale,
                                      bg * sc.materials[m, col + 1] * scale,
                                      bb * sc.materials[m, col + 2] * scale,
@@ -322,7 +265,7 @@ def _start_roots(n, st, root_pixel, acc):
 
 
 def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
-                        mode, depth, branching, emit_scale):
+                        code, depth, branching):
     """Trace spp camera samples for each pixel with a classic integrator.
 
     ``buffers`` = (state A, state B, shadow queue, acc (B, 4), root_pixel (B,)).
@@ -349,7 +292,7 @@ def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
         for start in range(0, n, slice_nodes):
             end = min(n, start + slice_nodes)
             n_shadow, n_next = shade_classic(start, end, prim, cur, nxt, n_next, sq, acc, sc, cfg,
-                                             fcfg, stats, mode, depth, branching, emit_scale)
+                                             fcfg, stats, code, depth, branching)
             if n_shadow:
                 occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
                 stats[ST_SHADOW_RAYS] += n_shadow

@@ -36,9 +36,8 @@ import math
 
 import numpy as np
 
-from .jit import device
-from .sampling import (disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf,
-                       uniform_triangle)
+from ..jit import device
+from .sampling import disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf
 
 LT_POINT = 0
 LT_SPOT = 1
@@ -179,31 +178,6 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
     return table, np.maximum(power, 0.0)
 
 
-def light_distribution(lamp_power, tri_power):
-    """CDF over lamps then emissive triangles; (cdf, lamp pmf, triangle pmf)."""
-    w = np.concatenate([lamp_power, tri_power]).astype(np.float64)
-    total = w.sum()
-    if total <= 0.0:
-        return np.zeros(len(w) + 1), np.zeros(len(lamp_power)), np.zeros(len(tri_power))
-    pmf = w / total
-    cdf = np.concatenate([[0.0], np.cumsum(pmf)])
-    cdf[-1] = 1.0
-    return cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):]
-
-
-@device
-def pick_light(cdf, u):
-    """Index i with cdf[i] <= u < cdf[i+1] (binary search), skipping zero-width bins."""
-    lo, hi = 0, cdf.shape[0] - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if cdf[mid] <= u:
-            lo = mid
-        else:
-            hi = mid
-    return lo
-
-
 @device
 def _smoothstep(t):
     if t <= 0.0:
@@ -267,13 +241,6 @@ def lamp_importance(lamps, li, px, py, pz):
         att = max(spot_attenuation(lamps, li, dx, dy, dz), IMPORTANCE_FLOOR)
     r = lamps[li, L_RADIUS]
     return k * att / max(d2, r * r, 1e-12)
-
-
-@device
-def group_importance(group, px, py, pz):
-    """Irradiance estimate of all emissive triangles together: (cx, cy, cz, r^2, scale)."""
-    dx, dy, dz = px - group[0], py - group[1], pz - group[2]
-    return group[4] / max(dx * dx + dy * dy + dz * dz, group[3])
 
 
 @device
@@ -517,14 +484,3 @@ def sun_radiance(lamps, li, dx, dy, dz):
     if dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2] < cos_max:
         return 0.0, 0.0, 0.0, 0.0
     return lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], uniform_cone_pdf(cos_max)
-
-
-@device
-def sample_triangle_point(verts, tris, tri, u1, u2):
-    """Uniform point on triangle ``tri``."""
-    b1, b2 = uniform_triangle(u1, u2)
-    b0 = 1.0 - b1 - b2
-    a, b, c = tris[tri, 0], tris[tri, 1], tris[tri, 2]
-    return (b0 * verts[a, 0] + b1 * verts[b, 0] + b2 * verts[c, 0],
-            b0 * verts[a, 1] + b1 * verts[b, 1] + b2 * verts[c, 1],
-            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2])

@@ -1,0 +1,303 @@
+"""Next-event estimation: which light to sample, its sample, and the MIS weights of light found by rays.
+
+Lights are lamps (``lights``) and emissive triangles.  Next-event estimation
+at a shading point picks one light (path tracing) or visits every light
+(classic integrators):
+
+* ``PMF_GLOBAL``: one distribution over "all lamps, then all emissive
+  triangles" in proportion to an estimate of their power;
+* ``PMF_LOCAL``: in proportion to each light's estimated irradiance at the
+  point (``lamp_importance``), the emissive triangles counting as one light
+  (then one triangle by power);
+* ``PMF_EVERY``: every lamp, and the emissive triangles as one light.
+
+Emission that a BSDF-sampled ray finds (lamps it passes through, suns, emissive
+triangles) is weighted by the power heuristic against the probability that
+next-event estimation from the vertex the ray left would have produced it,
+with the same picking rule.
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from ..jit import device
+from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW, LF_USE_MIS,
+                     LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY, LF_VIS_TRANSMISSION, LT_SUN,
+                     intersect_lamp, lamp_importance, sample_lamp, sun_radiance)
+from .materials import M_EMISSION
+from .closures import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
+from .sampling import power_heuristic, uniform_triangle
+from .state import PF_CAMERA, PF_DIFFUSE, PF_GLOSSY, PF_MIS_SKIP, PF_REFLECT, PF_TRANSMIT
+
+# How a light's selection probability is known, for MIS weights.
+PMF_GLOBAL = 0            # by power, scene-wide (lamps[:, L_PMF], emit_pmf)
+PMF_EVERY = 1             # every light is sampled (classic integrators)
+PMF_LOCAL = 2             # by estimated irradiance at the vertex the ray left
+
+LightSample = namedtuple("LightSample", [
+    "wix", "wiy", "wiz",   # unit direction from the shading point to the light point
+    "dist",                # distance to it (inf for suns)
+    "lr", "lg", "lb",      # radiance / sampling pdf (pick probability included); 0: no light
+    "pdf",                 # solid-angle pdf incl. the pick probability (0: delta light, no MIS)
+    "use_mis",             # the light takes part in MIS
+    "cast_shadow",         # a shadow ray decides visibility
+    "exclude",             # BSDF lobe labels the light must not illuminate
+    "lnx", "lny", "lnz",   # emitter's unit normal (zero for lamps), to offset the shadow ray's end
+])
+
+
+@device
+def _no_light():
+    return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0)
+
+
+def light_distribution(lamp_power, tri_power):
+    """CDF over lamps then emissive triangles; (cdf, lamp pmf, triangle pmf)."""
+    w = np.concatenate([lamp_power, tri_power]).astype(np.float64)
+    total = w.sum()
+    if total <= 0.0:
+        return np.zeros(len(w) + 1), np.zeros(len(lamp_power)), np.zeros(len(tri_power))
+    pmf = w / total
+    cdf = np.concatenate([[0.0], np.cumsum(pmf)])
+    cdf[-1] = 1.0
+    return cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):]
+
+
+@device
+def pick_light(cdf, u):
+    """Index i with cdf[i] <= u < cdf[i+1] (binary search), skipping zero-width bins."""
+    lo, hi = 0, cdf.shape[0] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if cdf[mid] <= u:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@device
+def group_importance(group, px, py, pz):
+    """Irradiance estimate of all emissive triangles together: (cx, cy, cz, r^2, scale)."""
+    dx, dy, dz = px - group[0], py - group[1], pz - group[2]
+    return group[4] / max(dx * dx + dy * dy + dz * dz, group[3])
+
+
+@device
+def sample_triangle_point(verts, tris, tri, u1, u2):
+    """Uniform point on triangle ``tri``."""
+    b1, b2 = uniform_triangle(u1, u2)
+    b0 = 1.0 - b1 - b2
+    a, b, c = tris[tri, 0], tris[tri, 1], tris[tri, 2]
+    return (b0 * verts[a, 0] + b1 * verts[b, 0] + b2 * verts[c, 0],
+            b0 * verts[a, 1] + b1 * verts[b, 1] + b2 * verts[c, 1],
+            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2])
+
+
+
+@device
+def lamp_visible_to_ray(flags, lamp_flags):
+    """Cycles' is_light_shader_visible_to_path for a ray of the given path flags."""
+    if flags & PF_CAMERA:
+        return (lamp_flags & LF_VIS_CAMERA) != 0
+    if (lamp_flags & LF_USE_MIS) == 0:
+        return False
+    if (flags & PF_DIFFUSE) and not (lamp_flags & LF_VIS_DIFFUSE):
+        return False
+    if (flags & PF_GLOSSY) and (flags & PF_REFLECT) and not (lamp_flags & LF_VIS_GLOSSY):
+        return False
+    if (flags & PF_TRANSMIT) and not (lamp_flags & LF_VIS_TRANSMISSION):
+        return False
+    return True
+
+
+@device
+def nee_exclude(lamp_flags):
+    """BSDF lobes a light must not illuminate (its ray-visibility switches)."""
+    ex = 0
+    if not (lamp_flags & LF_VIS_DIFFUSE):
+        ex |= LABEL_DIFFUSE
+    if not (lamp_flags & LF_VIS_GLOSSY):
+        ex |= LABEL_GLOSSY
+    if not (lamp_flags & LF_VIS_TRANSMISSION):
+        ex |= LABEL_TRANSMIT
+    return ex
+
+
+@device
+def local_light_total(lamps, group, has_group, px, py, pz):
+    """Sum of every light's importance at p (lamps, and the emissive triangles as one)."""
+    total = 0.0
+    for li in range(lamps.shape[0]):
+        total += lamp_importance(lamps, li, px, py, pz)
+    if has_group:
+        total += group_importance(group, px, py, pz)
+    return total
+
+
+@device
+def lamp_pick_pmf(lamps, li, pmf_mode, px, py, pz, total):
+    """Probability that next-event estimation at p picks lamp li."""
+    if pmf_mode == PMF_EVERY:
+        return 1.0
+    if pmf_mode == PMF_LOCAL:
+        return lamp_importance(lamps, li, px, py, pz) / total if total > 0.0 else 0.0
+    return lamps[li, L_PMF]
+
+
+@device
+def pick_light_local(lamps, group, has_group, px, py, pz, u):
+    """Pick a light at p in proportion to its importance there.
+
+    Returns ``(choice, pmf)``: a lamp index, or ``n_lamps`` for the emissive
+    triangles as a group; ``pmf`` 0 if nothing can light p.
+    """
+    n_lamps = lamps.shape[0]
+    total = local_light_total(lamps, group, has_group, px, py, pz)
+    if total <= 0.0:
+        return 0, 0.0
+    target = u * total
+    acc = 0.0
+    last = -1
+    last_w = 0.0
+    for li in range(n_lamps):
+        w = lamp_importance(lamps, li, px, py, pz)
+        if w > 0.0:
+            acc += w
+            last, last_w = li, w
+            if target < acc:
+                return li, w / total
+    if has_group:
+        return n_lamps, group_importance(group, px, py, pz) / total
+    return last, last_w / total      # rounding at the end of the scan
+
+
+@device
+def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+                     mpx, mpy, mpz, mis_total, transparent_left):
+    """Light from lamps the ray passes through before t_hit (lamps do not block rays).
+
+    Lamps are visited nearest first; each one counts as a transparent bounce
+    (Cycles), at most ``transparent_left`` of them.  MIS weights use the NEE
+    pdf of the lamp: its selection probability (see :func:`lamp_pick_pmf`)
+    times the solid-angle pdf.
+    Returns ``(r, g, b, lamps_passed)``, unweighted by the path throughput.
+    """
+    lr_sum = lg_sum = lb_sum = 0.0
+    passed = 0
+    last_t = 0.0
+    n_lamps = lamps.shape[0]
+    more = True
+    while more and passed < transparent_left:
+        best_t = t_hit
+        best = -1
+        n_hits = 0
+        br = bg = bb = bpdf = 0.0
+        for li in range(n_lamps):
+            if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
+                continue
+            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
+                                                  mpx, mpy, mpz)
+            if tl > last_t and tl < t_hit:
+                n_hits += 1
+                if tl < best_t:
+                    best_t, best = tl, li
+                    br, bg, bb, bpdf = lr, lg, lb, lpdf
+        if best < 0:
+            break
+        w = 1.0
+        if not (flags & PF_MIS_SKIP):
+            pmf = lamp_pick_pmf(lamps, best, pmf_mode, mpx, mpy, mpz, mis_total)
+            w = power_heuristic(mis_pdf, pmf * bpdf)
+        lr_sum += br * w
+        lg_sum += bg * w
+        lb_sum += bb * w
+        passed += 1
+        last_t = best_t
+        more = n_hits > 1
+    return lr_sum, lg_sum, lb_sum, passed
+
+
+@device
+def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total):
+    """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
+    r = g = b = 0.0
+    for li in range(lamps.shape[0]):
+        if int(lamps[li, L_TYPE]) != LT_SUN or lamps[li, L_SUN_COS] >= 1.0:
+            continue
+        lflags = int(lamps[li, L_FLAGS])
+        if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):
+            continue
+        lr, lg, lb, lpdf = sun_radiance(lamps, li, dx, dy, dz)
+        if lpdf > 0.0:
+            w = 1.0
+            if not (flags & PF_MIS_SKIP):
+                pmf = lamp_pick_pmf(lamps, li, pmf_mode, mpx, mpy, mpz, mis_total)
+                w = power_heuristic(mis_pdf, pmf * lpdf)
+            r += lr * w
+            g += lg * w
+            b += lb * w
+    return r, g, b
+
+
+@device
+def emission_weight(tri_light, emit_pmf, tri_area, p, t_hit, cos_o_geo, flags, mis_pdf,
+                    emit_pmf_scale):
+    """MIS weight of emission found by a BSDF ray on emissive triangle p."""
+    if flags & PF_MIS_SKIP:
+        return 1.0
+    j = tri_light[p]
+    if j < 0:
+        return 1.0
+    light_pdf = emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (tri_area[p] * cos_o_geo)
+    return power_heuristic(mis_pdf, light_pdf)
+
+
+@device
+def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, materials,
+                 idx, pmf, hx, hy, hz, bounce, u1, u2):
+    """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h.
+
+    ``pmf`` is the probability with which the caller chose this light.
+    Returns the direction and distance to the light point,
+    the radiance divided by the sampling pdf (pmf included), the solid-angle
+    pdf (0 for delta lights, which get no MIS), the light's flags, and the
+    emitter's unit normal (zero for lamps) for offsetting the shadow ray's end,
+    as a :class:`LightSample`.  All-zero radiance means no contribution.
+    """
+    n_lamps = lamps.shape[0]
+    if idx < n_lamps:
+        lflags = int(lamps[idx, L_FLAGS])
+        if bounce > lamps[idx, L_MAX_BOUNCES]:
+            return _no_light()
+        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamps, idx, hx, hy, hz, u1, u2)
+        use_mis = (lflags & LF_USE_MIS) != 0
+        if pdf > 0.0:
+            pdf_l = pmf * pdf
+            lr, lg, lb = lr / pdf_l, lg / pdf_l, lb / pdf_l
+        else:   # delta light: L is already the L/pdf term
+            pdf_l = 0.0
+            use_mis = False
+            lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
+        return LightSample(wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis,
+                           (lflags & LF_CAST_SHADOW) != 0, nee_exclude(lflags), 0.0, 0.0, 0.0)
+    tri = emit_tri[idx - n_lamps]
+    qx, qy, qz = sample_triangle_point(verts, tris, tri, u1, u2)
+    lx, ly, lz = qx - hx, qy - hy, qz - hz
+    d2 = lx * lx + ly * ly + lz * lz
+    dist = math.sqrt(d2)
+    if dist <= 0.0:
+        return _no_light()
+    wix, wiy, wiz = lx / dist, ly / dist, lz / dist
+    lnx, lny, lnz = tri_normal[tri, 0], tri_normal[tri, 1], tri_normal[tri, 2]
+    cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
+    if cos_l <= 0.0:
+        return _no_light()
+    pdf_l = pmf * d2 / (tri_area[tri] * cos_l)
+    em = mat_index[tri]
+    return LightSample(wix, wiy, wiz, dist, materials[em, M_EMISSION] / pdf_l,
+                       materials[em, M_EMISSION + 1] / pdf_l, materials[em, M_EMISSION + 2] / pdf_l,
+                       pdf_l, True, True, 0, lnx, lny, lnz)

@@ -1,0 +1,284 @@
+"""Path tracing, wavefront style: the integrator that matches Cycles.
+
+One *chunk* is a batch of path samples (a range of film pixels times a few
+samples each).  A worker traces its chunk bounce by bounce:
+
+1. ``generate_camera_rays``      fill the path state and the ray buffers;
+2. ``Accel.closest``             one Embree call for all live rays;
+3. ``shade``                     emission (lamps, world, emissive triangles,
+                                 with MIS), Russian roulette, next-event
+                                 estimation (one light sample, a shadow ray),
+                                 BSDF sampling of the next direction;
+4. ``Accel.occluded``            one Embree call for all shadow rays;
+5. ``finish_bounce``             add unoccluded light, write finished paths to
+                                 the film, compact the live paths to the front.
+
+The algorithm follows Cycles (intern/cycles/kernel/integrator/) where that
+decides the expected value: bounce limits (a vertex scatters while no bounce
+counter exceeds its limit; the next vertex only collects emission), lamps
+that rays pass through, per-light visibility and MIS switches, light
+``max_bounces`` gating NEE only, clamping per contribution, Russian roulette
+from the third vertex on, film transparency.  The steps shared with the
+classic integrators are in ``shading``.
+
+Stages are scalar loops compiled by numba (``nogil``), so two workers in two
+Python threads keep both cores busy; Embree releases the GIL as well.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..jit import device, kernel
+from .camera import generate_camera_rays
+from .closures import LABEL_DIFFUSE, LABEL_REFLECT
+from .intersect import offset_origin
+from .light_sampling import (PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light,
+                             pick_light_local)
+from .materials import M_EMISSIVE, bsdf_has_lobes
+from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_LIGHT_GROUP, DIM_LIGHT_PICK,
+                       DIM_LIGHT_U, DIM_LIGHT_V, DIM_ROULETTE, bounce_dim, rand)
+from .shading import (direct_light, light_from_background, light_from_emitter, light_from_lamps,
+                      next_path_flags, sample_direction, set_ray)
+from .state import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_LOCAL_LIGHTS, CFG_MAX_BOUNCE, CFG_MAX_DIFFUSE,
+                    CFG_MAX_GLOSSY, CFG_MAX_TRANSMISSION, CFG_MAX_TRANSPARENT,
+                    CFG_MIN_LIGHT_BOUNCES, FCFG_EMIT_SCALE, PF_MIS_SKIP, PF_TERMINATE,
+                    ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS, ST_SHADOW_RAYS)
+from .surface import hit_distance, local_frame, past_self_hit, surface_point
+
+
+# -- 3. shading ---------------------------------------------------------------------------------
+@kernel
+def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
+    """Shade the hits of the n live paths; returns the number of queued shadow rays."""
+    n_shadow = 0
+    n_lamps = sc.lamps.shape[0]
+    lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    local = cfg[CFG_LOCAL_LIGHTS] != 0
+    pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
+    has_group = sc.emit_tri.shape[0] > 0
+    for i in range(n):
+        st.alive[i] = 0
+        p = prim[i]
+        ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
+        dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
+        if p >= 0 and p == st.self_prim[i]:
+            stats[ST_SELF_HITS] += 1
+            s = past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz)
+            set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+                    ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, st.ray_tmax[i] - s)
+            st.alive[i] = 1
+            continue
+        flags = st.flags[i]
+        mis_pdf = st.mis_pdf[i]
+        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
+        direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
+        # Light-picking probabilities at the vertex this ray left, for MIS.
+        mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
+        mis_total = 0.0
+        if local and not (flags & PF_MIS_SKIP):
+            mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, mpx, mpy, mpz)
+
+        # -- light arriving along the ray ------------------------------------------------------
+        if lamps_hit:
+            passed = light_from_lamps(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i,
+                                      ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+                                      mpx, mpy, mpz, mis_total, st.transparent[i], direct)
+            if passed:
+                st.transparent[i] += passed
+                if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
+                    continue   # Cycles: the path ends after the lamp's light
+        if p < 0:
+            if light_from_background(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz,
+                                     flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct):
+                st.transparency[i] = 1.0
+            continue
+        if sc.tri_area[p] <= 0.0:
+            continue   # degenerate triangle: Embree should not report it; drop the path
+        sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+        m = sc.mat_index[p]
+
+        # Russian roulette (Cycles: from the third vertex on, with the
+        # throughput as it is; emission here is not affected by it).
+        q = 1.0
+        if st.bounce[i] > cfg[CFG_MIN_LIGHT_BOUNCES] + 1 and not (flags & PF_TERMINATE):
+            q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
+        if sc.materials[m, M_EMISSIVE] > 0.0:
+            light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, m, p, t_hit, sp.cos_o,
+                               flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct)
+        if (flags & PF_TERMINATE) or not bsdf_has_lobes(sc.materials, m):
+            continue
+        bounce = st.bounce[i]
+        key = st.key[i]
+        if q < 1.0:
+            if rand(key, bounce_dim(bounce, DIM_ROULETTE)) >= q:
+                continue
+            st.beta[i, 0] /= q
+            st.beta[i, 1] /= q
+            st.beta[i, 2] /= q
+        fr = local_frame(sp.nsx, sp.nsy, sp.nsz, dx, dy, dz)
+
+        # -- next-event estimation: one light --------------------------------------------------
+        if cfg[CFG_LIGHTS]:
+            u_pick = rand(key, bounce_dim(bounce, DIM_LIGHT_PICK))
+            if local:
+                idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, sp.hx, sp.hy, sp.hz,
+                                            u_pick)
+                if idx == n_lamps:
+                    j = pick_light(sc.emit_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_GROUP)))
+                    idx = n_lamps + j
+                    pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+            else:
+                idx = pick_light(sc.light_cdf, u_pick)
+                pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
+            n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i, m,
+                                    sp, fr, idx, pmf, bounce,
+                                    rand(key, bounce_dim(bounce, DIM_LIGHT_U)),
+                                    rand(key, bounce_dim(bounce, DIM_LIGHT_V)), True, 1.0)
+
+        # -- BSDF sampling: the next ray ---------------------------------------------------------
+        ds = sample_direction(sc.materials, m, sp, fr, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
+                              rand(key, bounce_dim(bounce, DIM_BSDF_U)),
+                              rand(key, bounce_dim(bounce, DIM_BSDF_V)))
+        if not ds.ok:
+            continue
+        st.beta[i, 0] *= ds.wr
+        st.beta[i, 1] *= ds.wg
+        st.beta[i, 2] *= ds.wb
+        st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label), ds.label)
+        st.mis_pdf[i] = ds.pdf
+        st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
+        nox, noy, noz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz,
+                                      ds.wix, ds.wiy, ds.wiz)
+        set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+                nox, noy, noz, ds.wix, ds.wiy, ds.wiz, math.inf)
+        st.self_prim[i] = p
+        st.alive[i] = 1
+    return n_shadow
+
+
+@device
+def count_bounce(st, i, cfg, flags, label):
+    """Count a scattering event of lobe ``label`` on path i (Cycles' path_state_next).
+
+    Returns ``flags`` with PF_TERMINATE added when a limit is passed: the next
+    vertex then collects emission only.
+    """
+    st.bounce[i] += 1
+    if st.bounce[i] > cfg[CFG_MAX_BOUNCE]:
+        flags |= PF_TERMINATE
+    if label & LABEL_REFLECT:
+        if label & LABEL_DIFFUSE:
+            st.diffuse[i] += 1
+            if st.diffuse[i] > cfg[CFG_MAX_DIFFUSE]:
+                flags |= PF_TERMINATE
+        else:
+            st.glossy[i] += 1
+            if st.glossy[i] > cfg[CFG_MAX_GLOSSY]:
+                flags |= PF_TERMINATE
+    else:
+        st.transmission[i] += 1
+        if st.transmission[i] > cfg[CFG_MAX_TRANSMISSION]:
+            flags |= PF_TERMINATE
+    return flags
+
+
+# -- 5. after the shadow rays ------------------------------------------------------------------
+@kernel
+def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
+    """Add unoccluded light, write finished paths to the film, compact the rest.
+
+    Returns the number of live paths, now at the front of the state arrays.
+    """
+    for s in range(n_shadow):
+        if not occluded[s]:
+            i = sq.path[s]
+            st.radiance[i, 0] += sq.contrib[s, 0]
+            st.radiance[i, 1] += sq.contrib[s, 1]
+            st.radiance[i, 2] += sq.contrib[s, 2]
+    m = 0
+    for i in range(n):
+        if st.alive[i]:
+            if m != i:
+                _move(st, i, m)
+            m += 1
+        else:
+            _splat(st, i, film_sum, film_sq, film_n)
+    return m
+
+
+@device
+def _splat(st, i, film_sum, film_sq, film_n):
+    pix = st.pixel[i]
+    r, g, b = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+    film_sum[pix, 0] += r
+    film_sum[pix, 1] += g
+    film_sum[pix, 2] += b
+    film_sum[pix, 3] += 1.0 - st.transparency[i]
+    film_sq[pix, 0] += r * r
+    film_sq[pix, 1] += g * g
+    film_sq[pix, 2] += b * b
+    film_n[pix] += 1
+
+
+@device
+def _move(st, i, m):
+    st.key[m] = st.key[i]
+    st.pixel[m] = st.pixel[i]
+    for c in range(3):
+        st.ray_o[m, c] = st.ray_o[i, c]
+        st.ray_d[m, c] = st.ray_d[i, c]
+        st.beta[m, c] = st.beta[i, c]
+        st.radiance[m, c] = st.radiance[i, c]
+        st.o32[m, c] = st.o32[i, c]
+        st.d32[m, c] = st.d32[i, c]
+        st.mis_p[m, c] = st.mis_p[i, c]
+    st.ray_tmax[m] = st.ray_tmax[i]
+    st.transparency[m] = st.transparency[i]
+    st.bounce[m] = st.bounce[i]
+    st.diffuse[m] = st.diffuse[i]
+    st.glossy[m] = st.glossy[i]
+    st.transmission[m] = st.transmission[i]
+    st.transparent[m] = st.transparent[i]
+    st.flags[m] = st.flags[i]
+    st.mis_pdf[m] = st.mis_pdf[i]
+    st.self_prim[m] = st.self_prim[i]
+    st.t32[m] = st.t32[i]
+
+
+@kernel
+def splat_all(n, st, film_sum, film_sq, film_n):
+    """Write all n paths to the film (end of a chunk)."""
+    for i in range(n):
+        _splat(st, i, film_sum, film_sq, film_n)
+
+
+def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, film, stats):
+    """Trace spp samples for each pixel in ``pixels`` to completion.
+
+    ``film`` is ``(film_sum, film_sq, film_n)``.  A chunk always runs to the
+    end (a fraction of a second): stopping paths half-way would keep the
+    short paths and drop the long ones, a bias.  The loop ends when no path
+    is alive; its bound guards against a path re-hitting its origin forever.
+    """
+    film_sum, film_sq, film_n = film
+    n = generate_camera_rays(pixels, spp, film_n, st, sc, cfg)
+    stats[ST_CAMERA_RAYS] += n
+    max_iterations = 4 * (int(cfg[CFG_MAX_BOUNCE]) + int(cfg[CFG_MAX_TRANSPARENT]) + 4)
+    first = True
+    for _ in range(max_iterations):
+        if n == 0:
+            break
+        if not first:
+            stats[ST_BOUNCE_RAYS] += n
+        first = False
+        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n])
+        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, stats)
+        if n_shadow:
+            occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
+            stats[ST_SHADOW_RAYS] += n_shadow
+        else:
+            occluded = np.zeros(0, np.bool_)
+        n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n)
+    splat_all(n, st, film_sum, film_sq, film_n)

@@ -1,0 +1,258 @@
+"""Shading steps shared by every integrator.
+
+The path tracer (``path``) and the classic integrators (``classic``) do the
+same things at a surface hit and differ only in how many rays they spawn and
+where the light goes; these device functions are those shared steps, in the
+order a hit is shaded:
+
+1. ``light_from_lamps``       lamps the ray passed through (they do not block rays);
+2. ``light_from_background``  an escaped ray: the world and suns with an angle;
+3. ``light_from_emitter``     the emission of the surface hit (two-sided);
+4. ``direct_light``           next-event estimation for one chosen light: a light
+                              sample, the BSDF, MIS, clamping, a queued shadow ray;
+5. ``sample_direction``       the BSDF picks the next direction, checked against
+                              the geometric side it must leave to.
+
+Light is added with ``add_light`` to row ``row`` of an (N, >=3) array ``out``
+(the path's radiance, or a classic integrator's per-camera-sample sums),
+weighted by the throughput ``beta[i]``.  ``direct`` selects Cycles' direct
+or indirect clamp.  ``pmf_mode`` says how next-event estimation picks lights
+(see ``light_sampling``), which the MIS weights of emission found by rays
+must follow; ``mpx, mpy, mpz`` is the vertex the ray left and ``mis_total``
+the sum of light importances there (``PMF_LOCAL`` only).
+
+Every step is inlined into its kernel (``jit.device``), so sharing costs
+nothing at run time.
+"""
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+from ..jit import device
+from .closures import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
+                       bsdf_eval, bsdf_sample)
+from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
+from .light_sampling import (PMF_EVERY, PMF_LOCAL, emission_weight, group_importance,
+                             lamps_on_segment, sample_light, sun_light)
+from .materials import M_EMISSION
+from .sampling import power_heuristic
+from .state import (CFG_MAX_TRANSPARENT, CFG_WORLD, CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT,
+                    FCFG_CLAMP_INDIRECT, FCFG_EMIT_SCALE, PF_CAMERA, PF_DIFFUSE, PF_GLOSSY,
+                    PF_MIS_SKIP, PF_REFLECT, PF_TERMINATE, PF_TRANSMIT, PF_TRANSPARENT_BG,
+                    ST_NONFINITE)
+
+DirectionSample = namedtuple("DirectionSample", [
+    "ok",                    # False: no direction (absorbed, or through the wrong side)
+    "wix", "wiy", "wiz",     # the new direction, world space
+    "wr", "wg", "wb",        # weight f * |cos| / pdf
+    "pdf",                   # solid-angle pdf (0 for a singular lobe)
+    "label",                 # LABEL_* of the lobe sampled
+])
+
+
+# -- adding light -----------------------------------------------------------------------------
+@device
+def clamp_light(r, g, b, limit, stats):
+    """Cycles' film_clamp_light: drop non-finite values, cap |r|+|g|+|b| at limit."""
+    if not (math.isfinite(r) and math.isfinite(g) and math.isfinite(b)):
+        stats[ST_NONFINITE] += 1
+        return 0.0, 0.0, 0.0
+    s = abs(r) + abs(g) + abs(b)
+    if s > limit:
+        k = limit / s
+        return r * k, g * k, b * k
+    return r, g, b
+
+
+@device
+def add_light(out, row, r, g, b, direct, fcfg, stats):
+    """Add a clamped contribution to row ``row`` of ``out`` (direct or indirect limit)."""
+    limit = fcfg[FCFG_CLAMP_DIRECT] if direct else fcfg[FCFG_CLAMP_INDIRECT]
+    r, g, b = clamp_light(r, g, b, limit, stats)
+    out[row, 0] += r
+    out[row, 1] += g
+    out[row, 2] += b
+
+
+# -- rays -----------------------------------------------------------------------------------------
+@device
+def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tmax):
+    """Write ray i (float64 and Embree's float32 copies)."""
+    ray_o[i, 0], ray_o[i, 1], ray_o[i, 2] = ox, oy, oz
+    ray_d[i, 0], ray_d[i, 1], ray_d[i, 2] = dx, dy, dz
+    ray_tmax[i] = tmax
+    o32[i, 0], o32[i, 1], o32[i, 2] = ox, oy, oz
+    d32[i, 0], d32[i, 1], d32[i, 2] = dx, dy, dz
+    t32[i] = min(tmax, T_INFINITE)
+
+
+@device
+def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb):
+    """Queue a shadow ray from the shading point ``sp`` towards the light point.
+
+    Returns the new queue length.  Both ends leave their surfaces (pbrt's
+    SpawnRayTo): the direction is re-aimed from the offset origin at the offset
+    target, else at grazing angles the shifted ray meets the emitter's plane
+    before its end.  ``owner`` is the row the light goes to if unoccluded.
+    """
+    hx, hy, hz = sp.hx, sp.hy, sp.hz
+    sox, soy, soz = offset_origin(hx, hy, hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
+    sdx, sdy, sdz = wix, wiy, wiz
+    tmax = T_INFINITE
+    if not math.isinf(dist):
+        ex, ey, ez = hx + dist * wix, hy + dist * wiy, hz + dist * wiz
+        if lnx != 0.0 or lny != 0.0 or lnz != 0.0:
+            ex, ey, ez = offset_origin(ex, ey, ez, lnx, lny, lnz, -wix, -wiy, -wiz)
+        sdx, sdy, sdz = ex - sox, ey - soy, ez - soz
+        length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
+        sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
+        tmax = length * (1.0 - SHADOW_SHORTEN)
+    sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
+    sq.d32[n_shadow, 0], sq.d32[n_shadow, 1], sq.d32[n_shadow, 2] = sdx, sdy, sdz
+    sq.t32[n_shadow] = tmax
+    sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
+    sq.path[n_shadow] = owner
+    return n_shadow + 1
+
+
+@device
+def next_path_flags(flags, label):
+    """Path flags after a BSDF sample with ``label`` (Cycles' path_state_next)."""
+    new = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_DIFFUSE |
+                    PF_GLOSSY | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
+    new |= PF_REFLECT if label & LABEL_REFLECT else PF_TRANSMIT
+    if label & LABEL_DIFFUSE:
+        new |= PF_DIFFUSE
+    elif label & LABEL_GLOSSY:
+        new |= PF_GLOSSY
+    else:   # singular: a glossy ray for light visibility, no MIS at its hit
+        new |= PF_GLOSSY | PF_MIS_SKIP
+    return new
+
+
+# -- 1-3. light arriving along the ray ---------------------------------------------------------
+@device
+def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy, dz, t_hit,
+                     flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, transparent, direct):
+    """Add the light of lamps the ray passes before t_hit; returns how many it passed.
+
+    Each lamp passed counts as a transparent bounce (Cycles), at most as many
+    as ``transparent`` (the bounces made so far) leaves below the limit.
+    """
+    lr, lg, lb, passed = lamps_on_segment(
+        sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+        mpx, mpy, mpz, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent)
+    if passed:
+        add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg, stats)
+    return passed
+
+
+@device
+def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
+                          pmf_mode, mpx, mpy, mpz, mis_total, direct):
+    """Add the world's and the suns' light to an escaped ray.
+
+    Returns True where the film is transparent (a camera ray on a transparent
+    film sees no background: alpha 0 there).
+    """
+    transparent_film = (flags & PF_TRANSPARENT_BG) != 0
+    if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
+        add_light(out, row, beta[i, 0] * sc.world[0], beta[i, 1] * sc.world[1],
+                  beta[i, 2] * sc.world[2], direct, fcfg, stats)
+    if sc.lamps.shape[0]:
+        lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
+                               mpx, mpy, mpz, mis_total)
+        if lr + lg + lb > 0.0:
+            add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
+                      stats)
+    return transparent_film
+
+
+@device
+def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
+    """Factor from an emissive triangle's scene-wide pick probability (``emit_pmf``)
+    to the probability that next-event estimation at m picked it."""
+    if pmf_mode == PMF_EVERY:
+        return fcfg[FCFG_EMIT_SCALE]
+    if pmf_mode == PMF_LOCAL and mis_total > 0.0:
+        return group_importance(sc.emit_group, mpx, mpy, mpz) / mis_total * fcfg[FCFG_EMIT_SCALE]
+    return 1.0
+
+
+@device
+def light_from_emitter(sc, fcfg, stats, out, row, beta, i, m, p, t_hit, cos_o, flags, mis_pdf,
+                       pmf_mode, mpx, mpy, mpz, mis_total, direct):
+    """Add the emission of triangle p (material m, emissive) seen by the ray, MIS-weighted."""
+    scale = emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total)
+    w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o, flags,
+                        mis_pdf, scale)
+    add_light(out, row, beta[i, 0] * sc.materials[m, M_EMISSION] * w,
+              beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
+              beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, direct, fcfg, stats)
+
+
+# -- 4. next-event estimation -----------------------------------------------------------------
+@device
+def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, idx, pmf, bounce,
+                 u1, u2, mis_on, bsdf_pdf_scale):
+    """Light from light ``idx`` (picked with probability ``pmf``) reflected at ``sp``.
+
+    The light is added to ``out[row]`` at once if the light casts no shadow,
+    else queued behind a shadow ray owned by ``row``; returns the queue length.
+    With ``mis_on`` the power heuristic weighs it against BSDF sampling, whose
+    pdf is scaled by ``bsdf_pdf_scale`` (the number of BSDF rays per hit).
+    """
+    if pmf <= 0.0:
+        return n_shadow
+    ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
+                      sc.mat_index, sc.materials, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
+    wix, wiy, wiz = ls.wix, ls.wiy, ls.wiz
+    if ls.lr + ls.lg + ls.lb <= 0.0 or wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz <= 0.0:
+        return n_shadow
+    fr_, fg_, fb_, bsdf_pdf = bsdf_eval(
+        sc.materials, m, fr.wox, fr.woy, fr.woz, wix * fr.tx + wiy * fr.ty + wiz * fr.tz,
+        wix * fr.bx + wiy * fr.by + wiz * fr.bz, wix * sp.nsx + wiy * sp.nsy + wiz * sp.nsz,
+        ls.exclude)
+    w = power_heuristic(ls.pdf, bsdf_pdf_scale * bsdf_pdf) if (mis_on and ls.use_mis) else 1.0
+    cr = beta[i, 0] * fr_ * ls.lr * w
+    cg = beta[i, 1] * fg_ * ls.lg * w
+    cb = beta[i, 2] * fb_ * ls.lb * w
+    if cr + cg + cb <= 0.0:
+        return n_shadow
+    limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
+    cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
+    if ls.cast_shadow:
+        return push_shadow(sq, n_shadow, row, sp, wix, wiy, wiz, ls.dist, ls.lnx, ls.lny, ls.lnz,
+                           cr, cg, cb)
+    out[row, 0] += cr
+    out[row, 1] += cg
+    out[row, 2] += cb
+    return n_shadow
+
+
+# -- 5. the next direction -----------------------------------------------------------------------
+@device
+def to_world(sp, fr, wlx, wly, wlz, label):
+    """(ok, wix, wiy, wiz): a local direction in world space, and whether it
+    leaves to the side of the geometric surface its lobe says (reflection to
+    the viewer's side, transmission to the other); a shading normal can
+    otherwise send a ray through the wrong side."""
+    wix = wlx * fr.tx + wly * fr.bx + wlz * sp.nsx
+    wiy = wlx * fr.ty + wly * fr.by + wlz * sp.nsy
+    wiz = wlx * fr.tz + wly * fr.bz + wlz * sp.nsz
+    cos_i_geo = wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz
+    ok = not ((label & LABEL_REFLECT and cos_i_geo <= 0.0)
+              or (label & LABEL_TRANSMIT and cos_i_geo >= 0.0))
+    return ok, wix, wiy, wiz
+
+
+@device
+def sample_direction(mats, m, sp, fr, u_lobe, u1, u2):
+    """The BSDF of material m samples the next direction at ``sp``."""
+    wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
+        mats, m, fr.wox, fr.woy, fr.woz, sp.backfacing, u_lobe, u1, u2)
+    if (pdf <= 0.0 and not (label & LABEL_SINGULAR)) or wr + wg + wb <= 0.0:
+        return DirectionSample(False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, label)
+    ok, wix, wiy, wiz = to_world(sp, fr, wlx, wly, wlz, label)
+    return DirectionSample(ok, wix, wiy, wiz, wr, wg, wb, pdf, label)

@@ -1,0 +1,130 @@
+"""The wavefront's data: path state, shadow queue, packed scene, settings and counters.
+
+Every stage kernel reads and writes these structure-of-arrays records; each
+field is one array indexed by path (or shadow ray, or scene element).  They
+are allocated once per worker (``alloc_path_state``, ``alloc_shadow_queue``)
+and reused, so memory is bounded by the batch size.  The integer codes below
+(path flags, settings, counters) are shared by every integrator.
+"""
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+
+# -- path state ----------------------------------------------------------------------
+PathState = namedtuple("PathState", [
+    "key",           # (B,) uint64   RNG key of the path sample
+    "pixel",         # (B,) int32    film pixel (index into the film region)
+    "root",          # (B,) int32    camera sample a ray belongs to (classic integrators)
+    "ray_o",         # (B, 3) f64    ray origin
+    "ray_d",         # (B, 3) f64    unit ray direction
+    "ray_tmax",      # (B,) f64      ray length (far clip for camera rays)
+    "beta",          # (B, 3) f64    path throughput
+    "radiance",      # (B, 3) f64    radiance collected so far
+    "transparency",  # (B,) f64      1 if the camera ray escaped to a transparent film
+    "bounce",        # (B,) int32    scattering events so far (= index of the next vertex)
+    "diffuse",       # (B,) int32    diffuse scattering events so far
+    "glossy",        # (B,) int32
+    "transmission",  # (B,) int32
+    "transparent",   # (B,) int32    transparent passes (lamps count as one)
+    "flags",         # (B,) int32    PF_* bits
+    "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
+    "mis_p",         # (B, 3) f64    the vertex that ray left (light picking there, for MIS)
+    "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
+    "alive",         # (B,) uint8    still tracing after this bounce
+    "o32",           # (B, 3) f32    Embree input: origins
+    "d32",           # (B, 3) f32    Embree input: directions
+    "t32",           # (B,) f32      Embree input: tfar
+])
+
+ShadowQueue = namedtuple("ShadowQueue", [
+    "o32", "d32", "t32",   # Embree input
+    "contrib",             # (B, 3) f64  radiance to add if unoccluded
+    "path",                # (B,) int32  path the contribution belongs to
+])
+
+SceneData = namedtuple("SceneData", [
+    "verts",         # (V, 3) f64
+    "tris",          # (T, 3) int32
+    "normals",       # (T, 3, 3) f32  shading normals at the corners
+    "mat_index",     # (T,) int32
+    "materials",     # (M, MATERIAL_STRIDE) f64
+    "lamps",         # (NL, LIGHT_STRIDE) f64
+    "light_cdf",     # (NL + NE + 1,) f64  NEE light distribution
+    "emit_tri",      # (NE,) int32  emissive triangle ids
+    "emit_pmf",      # (NE,) f64    their NEE probabilities
+    "emit_cdf",      # (NE + 1,) f64  distribution over emissive triangles alone
+    "emit_group",    # (5,) f64     emissive triangles as one light: centre, radius^2, scale
+    "tri_light",     # (T,) int32   index into emit_tri, or -1
+    "tri_area",      # (T,) f64
+    "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
+    "world",         # (3,) f64     background radiance
+    "camera",        # (CAMERA_PARAMS,) f64
+    "filter_table",  # (FILTER_TABLE_SIZE,) f64
+])
+
+# Path flags.
+PF_CAMERA = 1            # no scattering yet: the ray is a camera ray
+PF_MIS_SKIP = 2          # emission found by this ray gets MIS weight 1
+PF_TERMINATE = 4         # a bounce limit was reached: the next hit only collects emission
+PF_TRANSPARENT_BG = 8    # camera ray on a transparent film: the background gives alpha 0
+PF_DIFFUSE = 16          # label of the BSDF sample that made the ray
+PF_GLOSSY = 32
+PF_TRANSMIT = 64
+PF_REFLECT = 128
+
+# Integer settings (cfg array).
+CFG_MAX_BOUNCE = 0
+CFG_MAX_DIFFUSE = 1
+CFG_MAX_GLOSSY = 2
+CFG_MAX_TRANSMISSION = 3
+CFG_MAX_TRANSPARENT = 4
+CFG_MIN_LIGHT_BOUNCES = 5
+CFG_SEED = 6
+CFG_FILM_TRANSPARENT = 7
+CFG_WORLD_CAMERA = 8      # world visible to camera rays
+CFG_LAMPS_HIT = 9         # some lamp can be hit by rays (Cycles' use_light_mis)
+CFG_REGION_X = 10         # film region origin and width in the full frame
+CFG_REGION_Y = 11
+CFG_REGION_W = 12
+CFG_FULL_W = 13
+CFG_LIGHTS = 14           # NEE has something to sample
+CFG_WORLD = 15            # the world is not black
+CFG_LOCAL_LIGHTS = 16     # pick lights by their estimated irradiance at each point
+CFG_SIZE = 17
+# Float settings (fcfg array).
+FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
+FCFG_CLAMP_INDIRECT = 1
+FCFG_EMIT_SCALE = 2       # 1 / (share of the emissive triangles in the scene-wide pmf)
+FCFG_SIZE = 3
+
+# Statistics counters (stats array, per worker).
+ST_CAMERA_RAYS = 0
+ST_BOUNCE_RAYS = 1
+ST_SHADOW_RAYS = 2
+ST_SELF_HITS = 3          # rays that re-hit their origin triangle and were re-traced
+ST_NONFINITE = 4          # contributions dropped because they were NaN or infinite
+ST_SIZE = 5
+
+
+def alloc_path_state(n: int) -> PathState:
+    """Buffers for n paths, allocated once per worker and reused."""
+    return PathState(
+        key=np.zeros(n, np.uint64), pixel=np.zeros(n, np.int32), root=np.zeros(n, np.int32),
+        ray_o=np.zeros((n, 3)), ray_d=np.zeros((n, 3)), ray_tmax=np.zeros(n),
+        beta=np.zeros((n, 3)), radiance=np.zeros((n, 3)), transparency=np.zeros(n),
+        bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
+        glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
+        transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
+        mis_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
+        alive=np.zeros(n, np.uint8),
+        o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
+        t32=np.zeros(n, np.float32))
+
+
+def alloc_shadow_queue(n: int) -> ShadowQueue:
+    return ShadowQueue(o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
+                       t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
+                       path=np.zeros(n, np.int32))
+

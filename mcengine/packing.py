@@ -1,0 +1,127 @@
+"""Packing: a scene description turned into the flat arrays the kernels read.
+
+The scene model (``scene``) is made for people and files; the kernels want
+contiguous float64/int32 tables with fixed columns (``kernels.state``,
+``kernels.lights``, ``kernels.materials``, ``kernels.camera``), the light
+picking distributions, and two small settings vectors (``cfg`` integers,
+``fcfg`` floats) that also carry the decisions of ``features``.  This module
+builds all of them once per render.
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .features import Features, detect as detect_features
+from .kernels.camera import pack_camera
+from .kernels.light_sampling import light_distribution
+from .kernels.lights import L_PMF, pack_lights
+from .kernels.materials import M_EMISSION, M_EMISSIVE, pack_materials
+from .kernels.sampling import filter_table
+from .kernels.state import (CFG_FILM_TRANSPARENT, CFG_FULL_W, CFG_LAMPS_HIT, CFG_LIGHTS,
+                            CFG_LOCAL_LIGHTS, CFG_MAX_BOUNCE, CFG_MAX_DIFFUSE, CFG_MAX_GLOSSY,
+                            CFG_MAX_TRANSMISSION, CFG_MAX_TRANSPARENT, CFG_MIN_LIGHT_BOUNCES,
+                            CFG_REGION_W, CFG_REGION_X, CFG_REGION_Y, CFG_SEED, CFG_SIZE,
+                            CFG_WORLD, CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT,
+                            FCFG_EMIT_SCALE, FCFG_SIZE, SceneData)
+from .scene import SceneDescription
+
+LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
+
+
+class PackedScene(NamedTuple):
+    sc: SceneData          # the scene's tables
+    cfg: np.ndarray        # (CFG_SIZE,) int64 settings
+    fcfg: np.ndarray       # (FCFG_SIZE,) float64 settings
+    features: Features     # what the scene calls for
+
+
+def pack_scene(scene: SceneDescription) -> PackedScene:
+    """Pack a scene description into the kernels' arrays (see :class:`PackedScene`)."""
+    g = scene.geometry
+    verts = g.vertices.astype(np.float64)
+    tris = np.ascontiguousarray(g.triangles, np.int32)
+    if len(tris):
+        p = verts[tris]
+        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        length = np.linalg.norm(cross, axis=1)
+        tri_area = 0.5 * length
+        tri_normal = cross / np.where(length > 0, length, 1.0)[:, None]
+        lo, hi = verts.min(axis=0), verts.max(axis=0)
+    else:
+        tri_area = np.zeros(0)
+        tri_normal = np.zeros((0, 3))
+        lo = hi = np.zeros(3)
+    lamp_pos = [np.asarray(li.matrix_world, float)[:3, 3] for li in scene.lights if li.type != "SUN"]
+    if lamp_pos:
+        lo = np.minimum(lo, np.min(lamp_pos, axis=0))
+        hi = np.maximum(hi, np.max(lamp_pos, axis=0))
+    scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
+
+    materials = pack_materials(scene.materials)
+    mat_index = np.ascontiguousarray(g.material_index, np.int32)
+    emissive = (materials[mat_index, M_EMISSIVE] > 0.0) & (tri_area > 0.0) if len(tris) else np.zeros(0, bool)
+    emit_tri = np.flatnonzero(emissive).astype(np.int32)
+    emit_power = materials[mat_index[emit_tri], M_EMISSION:M_EMISSION + 3].mean(axis=1) * math.pi * tri_area[emit_tri]
+    tri_light = np.full(len(tris), -1, np.int32)
+    tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
+
+    lamps, lamp_power = pack_lights(scene.lights, scene_radius)
+    cdf, lamp_pmf, emit_pmf = light_distribution(lamp_power, emit_power)
+    emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
+    if emit_cdf[-1] > 0:
+        emit_cdf /= emit_cdf[-1]
+    # The emissive triangles as one light for per-point picking: its centre,
+    # its radius squared (the distance floor) and an irradiance scale.
+    emit_group = np.zeros(5)
+    if len(emit_tri):
+        corners = verts[tris[emit_tri]].reshape(-1, 3)
+        lo_e, hi_e = corners.min(axis=0), corners.max(axis=0)
+        emit_group[:3] = 0.5 * (lo_e + hi_e)
+        emit_group[3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
+        emit_group[4] = emit_power.sum() / math.pi
+    if len(lamps):
+        lamps[:, L_PMF] = lamp_pmf
+    feats = detect_features(scene, len(emit_tri), lamp_power)
+
+    film = scene.film
+    x0, y0, x1, y1 = film.window
+    world = np.asarray(scene.world.color, np.float64).reshape(3)
+    sc = SceneData(
+        verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
+        mat_index=mat_index, materials=materials,
+        lamps=lamps,
+        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf,
+        emit_group=emit_group, tri_light=tri_light,
+        tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
+        filter_table=filter_table(film.filter_type, film.filter_width))
+
+    it = scene.integrator
+    cfg = np.zeros(CFG_SIZE, np.int64)
+    cfg[CFG_MAX_BOUNCE] = it.max_bounces
+    cfg[CFG_MAX_DIFFUSE] = it.diffuse_bounces
+    cfg[CFG_MAX_GLOSSY] = it.glossy_bounces
+    cfg[CFG_MAX_TRANSMISSION] = it.transmission_bounces
+    cfg[CFG_MAX_TRANSPARENT] = it.transparent_max_bounces
+    cfg[CFG_MIN_LIGHT_BOUNCES] = it.min_light_bounces
+    cfg[CFG_SEED] = it.seed & 0x7FFFFFFFFFFFFFFF
+    cfg[CFG_FILM_TRANSPARENT] = 1 if film.transparent else 0
+    cfg[CFG_WORLD_CAMERA] = 1 if scene.world.visible_camera else 0
+    cfg[CFG_LAMPS_HIT] = 1 if feats.lamps_hit else 0
+    cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W] = x0, y0, x1 - x0
+    cfg[CFG_FULL_W] = film.width
+    cfg[CFG_LIGHTS] = 1 if feats.nee else 0
+    cfg[CFG_WORLD] = 1 if feats.world else 0
+    fcfg = np.zeros(FCFG_SIZE)
+    # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.
+    fcfg[FCFG_CLAMP_DIRECT] = 3.0 * it.clamp_direct if it.clamp_direct > 0 else math.inf
+    fcfg[FCFG_CLAMP_INDIRECT] = 3.0 * it.clamp_indirect if it.clamp_indirect > 0 else math.inf
+    emit_share = float(emit_pmf.sum())
+    fcfg[FCFG_EMIT_SCALE] = 1.0 / emit_share if emit_share > 0 else 0.0
+    # Per-point light picking pays for itself when there is a choice to make and
+    # the scan over lamps stays short.
+    n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
+    cfg[CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
+    return PackedScene(sc, cfg, fcfg, feats)

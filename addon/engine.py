@@ -29,10 +29,15 @@ ENGINE_ID = "MCENGINE"
 log = logging.getLogger(__name__)
 
 
+# Blender's own image memory per rendered pixel: the render result's float RGBA
+# pass, and the copy the image editor and file output make of it.
+BLENDER_BYTES_PER_PIXEL = 2 * 4 * 4
+
+
 def default_session_factory(scene, threads=None):
     """Create the core's render session (imported lazily: it loads numba kernels)."""
     from mcengine.session import RenderSession
-    return RenderSession(scene, threads=threads)
+    return RenderSession(scene, threads=threads, host_bytes_per_pixel=BLENDER_BYTES_PER_PIXEL)
 
 
 #: Callable ``(SceneDescription, threads=None) -> session``; tests replace it with a fake.
@@ -128,14 +133,13 @@ class MCEngine(bpy.types.RenderEngine):
             settings["last_accounting"] = line
 
     def _write_pixels(self, result, session) -> None:
-        """Copy ``session.image()`` (top row first) into the Combined pass (bottom row first)."""
-        image = np.asarray(session.image(), np.float32)
+        """Copy the session's image into the Combined pass (Blender's rows: bottom first)."""
+        image = np.asarray(session.image(bottom_up=True), np.float32)
         width, height = result.resolution_x, result.resolution_y
         if image.shape != (height, width, 4):
             raise SceneError(f"the renderer returned an image of shape {image.shape} for a "
                              f"{width}x{height} render region")
-        rect = np.ascontiguousarray(image[::-1]).reshape(-1)
-        result.layers[0].passes["Combined"].rect.foreach_set(rect)
+        result.layers[0].passes["Combined"].rect.foreach_set(image.reshape(-1))
         self.update_result(result)
 
     def _stop_requested(self) -> bool:

@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 
+from .film import BLOCK_PIXELS
+
 
 class Adaptive:
     """Adaptive sampling: pixels stop once their estimated noise is below a threshold.
@@ -42,15 +44,17 @@ class Adaptive:
 
     def error(self, film):
         """(n,) relative error of every film pixel (inf below 2 samples)."""
-        n = film.count.astype(np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            mean = film.sum[:, :3] / n[:, None]
-            var = (film.sum_sq - n[:, None] * mean * mean) / (n[:, None] - 1.0) / n[:, None]
-            se = np.sqrt(np.maximum(var, 0.0).sum(axis=1))
-            total = mean.sum(axis=1)
-            scale = np.where(total < 1.0, np.sqrt(np.maximum(total, 0.0)), total)
-            err = se / (1e-4 + scale)
-        return np.where(n >= 2, err, np.inf)
+        n = film.count.size
+        err = np.empty(n)
+        for a in range(0, n, BLOCK_PIXELS):
+            b = min(n, a + BLOCK_PIXELS)
+            var = film.mean_variance(a, b)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                se = np.sqrt(var.sum(axis=1))
+                total = (film.sum[a:b, :3] / np.maximum(film.count[a:b], 1)[:, None]).sum(axis=1)
+                scale = np.where(total < 1.0, np.sqrt(np.maximum(total, 0.0)), total)
+                err[a:b] = se / (1e-4 + scale)
+        return err
 
     def unconverged(self, film, done):
         """Indices of the pixels that keep sampling after ``done`` samples."""

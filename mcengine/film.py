@@ -4,11 +4,16 @@ Each finished path adds its radiance (and alpha) to its pixel's sums; the
 image is the per-pixel mean, so pixels may hold different sample counts (an
 interrupted pass, adaptive sampling).  The sum of squares gives each pixel's
 sample variance, from which ``variance()`` estimates the variance of the
-pixel mean.  Memory is proportional to the film region, never to samples.
+pixel mean.  Memory is proportional to the film region, never to samples:
+``memory.FILM_BYTES_PER_PIXEL`` for the sums, and read-out works through
+blocks of rows, so it needs no full-frame float64 temporaries, only the
+float32 image it returns.
 """
 from __future__ import annotations
 
 import numpy as np
+
+BLOCK_PIXELS = 1 << 16     # pixels per read-out block (temporaries of a few MB)
 
 
 class Film:
@@ -19,30 +24,55 @@ class Film:
         n = self.width * self.height
         self.sum = np.zeros((n, 4))          # radiance RGB and alpha
         self.sum_sq = np.zeros((n, 3))       # squared radiance
-        self.count = np.zeros(n, np.int64)   # finished samples
+        self.count = np.zeros(n, np.int32)   # finished samples
 
     @property
     def arrays(self):
         return self.sum, self.sum_sq, self.count
 
-    def image(self, exposure: float = 1.0) -> np.ndarray:
-        """(h, w, 4) float32 mean RGBA; pixels without samples are 0."""
-        n = np.maximum(self.count, 1)[:, None]
-        img = self.sum / n
-        img[:, :3] *= exposure
-        return img.reshape(self.height, self.width, 4).astype(np.float32)
+    def _row_blocks(self):
+        """(first row, end row) of consecutive row blocks covering the film."""
+        rows = max(1, BLOCK_PIXELS // max(self.width, 1))
+        for r0 in range(0, self.height, rows):
+            yield r0, min(self.height, r0 + rows)
+
+    def image(self, exposure: float = 1.0, bottom_up: bool = False) -> np.ndarray:
+        """(h, w, 4) float32 mean RGBA; pixels without samples are 0.
+
+        ``bottom_up`` returns the rows in Blender's order (row 0 at the bottom),
+        still contiguous.
+        """
+        w, h = self.width, self.height
+        out = np.empty((h, w, 4), np.float32)
+        for r0, r1 in self._row_blocks():
+            a, b = r0 * w, r1 * w
+            block = self.sum[a:b] / np.maximum(self.count[a:b], 1)[:, None]
+            block[:, :3] *= exposure
+            rows = block.reshape(r1 - r0, w, 4)
+            if bottom_up:
+                out[h - r1:h - r0] = rows[::-1]
+            else:
+                out[r0:r1] = rows
+        return out
 
     def variance(self, exposure: float = 1.0) -> np.ndarray:
         """(h, w, 3) float32 estimated variance of each pixel's mean.
 
         Pixels with fewer than two samples get +inf (unknown).
         """
-        n = self.count[:, None].astype(np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            mean = self.sum[:, :3] / n
-            s2 = (self.sum_sq - n * mean * mean) / (n - 1.0)
-            var = np.where(n >= 2, np.maximum(s2, 0.0) / n, np.inf) * exposure * exposure
-        return var.reshape(self.height, self.width, 3).astype(np.float32)
+        w = self.width
+        out = np.empty((self.height, w, 3), np.float32)
+        for r0, r1 in self._row_blocks():
+            out[r0:r1] = self.mean_variance(r0 * w, r1 * w).reshape(r1 - r0, w, 3) * exposure ** 2
+        return out
+
+    def mean_variance(self, a: int, b: int) -> np.ndarray:
+        """(b - a, 3) float64 variance of the means of pixels a..b-1 (inf below 2 samples)."""
+        n = self.count[a:b, None].astype(np.float64)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            mean = self.sum[a:b, :3] / n
+            s2 = (self.sum_sq[a:b] - n * mean * mean) / (n - 1.0)
+            return np.where(n >= 2, np.maximum(s2, 0.0) / n, np.inf)
 
     def samples_min(self) -> int:
         return int(self.count.min()) if self.count.size else 0

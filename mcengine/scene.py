@@ -20,12 +20,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from . import integrators
+from . import integrators, memory
 
 __all__ = [
     "SceneError", "Geometry", "Material", "Light", "Camera", "World", "Film",
@@ -33,6 +35,11 @@ __all__ = [
 ]
 
 LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
+MAX_RESOLUTION = 65536          # pixels per side, Blender's own limit
+MAX_SAMPLES = 1 << 24           # Cycles' limit
+MAX_BOUNCES = 1024
+MIN_FILTER_WIDTH = 0.01         # pixels, Blender's own limit
+PI_FLOAT32 = float(np.float32(np.pi))
 AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
 
@@ -276,8 +283,9 @@ class SceneDescription:
                 raise SceneError(f"geometry.{name} has shape {arr.shape}, expected {shape}")
         if t and (g.triangles.min() < 0 or g.triangles.max() >= g.vertices.shape[0]):
             raise SceneError("geometry.triangles refers to vertices that do not exist")
-        if not np.all(np.isfinite(g.vertices)):
-            raise SceneError("geometry.vertices contains NaN or infinite coordinates")
+        for name in ("vertices", "normals", "uvs"):
+            if not np.all(np.isfinite(getattr(g, name))):
+                raise SceneError(f"geometry.{name} contains NaN or infinite values")
         if t and (g.material_index.min() < 0 or g.material_index.max() >= len(self.materials)):
             raise SceneError("geometry.material_index refers to a material that does not exist")
         if not self.materials:
@@ -290,40 +298,56 @@ class SceneDescription:
                 if v.shape != (3,) or not np.all(np.isfinite(v)) or np.any(v < 0):
                     raise SceneError(f"material '{m.name}': {attr} must be 3 finite non-negative values")
         for li in self.lights:
+            where = f"light '{li.name}'"
             if li.type not in LIGHT_TYPES:
-                raise SceneError(f"light '{li.name}': unknown type {li.type!r}")
+                raise SceneError(f"{where}: unknown type {li.type!r}")
             if li.type == "AREA" and li.shape not in AREA_SHAPES:
-                raise SceneError(f"light '{li.name}': unknown area shape {li.shape!r}")
-            m = np.asarray(li.matrix_world, float)
-            if m.shape != (4, 4) or not np.all(np.isfinite(m)):
-                raise SceneError(f"light '{li.name}': matrix_world must be a finite 4x4 matrix")
-            s = np.asarray(li.strength, float)
-            if s.shape != (3,) or not np.all(np.isfinite(s)):
-                raise SceneError(f"light '{li.name}': strength must be 3 finite values")
+                raise SceneError(f"{where}: unknown area shape {li.shape!r}")
+            _check_matrix(where, li.matrix_world)
+            _check_vector(where, "strength", li.strength, 3)
+            for attr in ("radius", "angle", "size_x", "size_y", "spot_blend"):
+                _check_number(where, attr, getattr(li, attr), lo=0.0)
+            # Blender stores angles as float32: pi arrives slightly above math.pi.
+            _check_number(where, "spot_size", li.spot_size, lo=0.0, hi=PI_FLOAT32)
+            _check_number(where, "spread", li.spread, lo=0.0, hi=PI_FLOAT32)
+            _check_number(where, "max_bounces", li.max_bounces, lo=0)
+        _check_vector("world", "color", self.world.color, 3)
         f = self.film
-        if f.width < 1 or f.height < 1:
-            raise SceneError(f"film resolution must be positive, got {f.width}x{f.height}")
+        for attr in ("width", "height"):
+            _check_number("film", attr, getattr(f, attr), lo=1, hi=MAX_RESOLUTION)
         x0, y0, x1, y1 = f.window
         if not (0 <= x0 < x1 <= f.width and 0 <= y0 < y1 <= f.height):
             raise SceneError(f"film region {f.window} is empty or outside the {f.width}x{f.height} frame")
         if f.filter_type not in FILTER_TYPES:
             raise SceneError(f"unknown pixel filter {f.filter_type!r}")
+        _check_number("film", "filter_width", f.filter_width, lo=MIN_FILTER_WIDTH)
+        _check_number("film", "exposure", f.exposure)
+        for attr in ("pixel_aspect_x", "pixel_aspect_y"):
+            _check_number("film", attr, getattr(f, attr), lo=1e-6)
         c = self.camera
         if c.type not in ("PERSP", "ORTHO"):
             raise SceneError(f"camera type {c.type!r} is not supported (PERSP, ORTHO)")
-        if c.type == "PERSP" and c.lens <= 0:
-            raise SceneError("camera focal length must be positive")
+        _check_matrix("camera", c.matrix_world, axes=True)
+        for attr in ("lens", "sensor_width", "sensor_height", "ortho_scale"):
+            _check_number("camera", attr, getattr(c, attr), lo=1e-9)
+        for attr in ("shift_x", "shift_y"):
+            _check_number("camera", attr, getattr(c, attr))
+        _check_number("camera", "clip_start", c.clip_start, lo=0.0)
+        _check_number("camera", "clip_end", c.clip_end, lo=c.clip_start + 1e-12)
+        if c.sensor_fit not in ("AUTO", "HORIZONTAL", "VERTICAL"):
+            raise SceneError(f"camera: unknown sensor_fit {c.sensor_fit!r} (AUTO, HORIZONTAL, VERTICAL)")
         i = self.integrator
         try:
             integrators.get(i.name)
             integrators.check_parameters(i.depth, i.branching)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
-        if i.samples < 1:
-            raise SceneError(f"samples must be at least 1, got {i.samples}")
-        for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
-            if getattr(i, attr) < 0:
-                raise SceneError(f"integrator.{attr} must not be negative")
+        _check_number("integrator", "samples", i.samples, lo=1, hi=MAX_SAMPLES)
+        for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                     "transparent_max_bounces", "min_light_bounces", "adaptive_min_samples"):
+            _check_number("integrator", attr, getattr(i, attr), lo=0, hi=MAX_BOUNCES)
+        for attr in ("clamp_direct", "clamp_indirect", "time_limit", "adaptive_threshold"):
+            _check_number("integrator", attr, getattr(i, attr), lo=0.0)
         return self
 
     # -- persistence -------------------------------------------------------
@@ -347,33 +371,87 @@ class SceneDescription:
 
     @staticmethod
     def load(path) -> "SceneDescription":
+        """Read a scene written by :meth:`save`, validated.
+
+        Any damaged, foreign or crafted file gives a :class:`SceneError`.  The
+        arrays' sizes are read from their headers first: a file that would not
+        fit in memory once decompressed is refused before it is decompressed.
+        """
         path = Path(path)
         try:
-            z = np.load(path, allow_pickle=False)
-            meta = json.loads(bytes(z["meta"]).decode())
-        except (OSError, KeyError, ValueError) as exc:
-            raise SceneError(f"{path}: not a saved mcengine scene ({exc})") from None
-        geom = Geometry(vertices=z["vertices"], triangles=z["triangles"], normals=z["normals"],
-                        uvs=z["uvs"], material_index=z["material_index"],
-                        object_index=z["object_index"], object_names=meta["object_names"])
-        lights = []
-        for d in meta["lights"]:
-            d["matrix_world"] = np.array(d["matrix_world"], float)
-            lights.append(Light(**{k: (tuple(v) if isinstance(v, list) and k != "matrix_world" else v)
-                                   for k, v in d.items()}))
-        cam = dict(meta["camera"])
-        cam["matrix_world"] = np.array(cam["matrix_world"], float)
-        film = dict(meta["film"])
-        if film.get("region") is not None:
-            film["region"] = tuple(film["region"])
-        return SceneDescription(
-            geometry=geom,
-            materials=[Material(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in d.items()})
-                       for d in meta["materials"]],
-            lights=lights, camera=Camera(**cam),
-            world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
-            film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
-            warnings=meta.get("warnings", []))
+            with zipfile.ZipFile(path) as archive:
+                arrays = _read_arrays(archive, path)
+            meta = json.loads(bytes(arrays.pop("meta")).decode())
+            scene = _from_saved(arrays, meta)
+        except SceneError:
+            raise
+        except (OSError, EOFError, KeyError, IndexError, TypeError, ValueError, AttributeError,
+                zipfile.BadZipFile) as exc:
+            raise SceneError(f"{path}: not a saved mcengine scene ({type(exc).__name__}: {exc})"
+                             ) from None
+        try:
+            return scene.validate()
+        except SceneError as exc:
+            raise SceneError(f"{path}: {exc}") from None
+
+
+# Arrays of a saved scene: name -> (dtype kind, trailing shape).
+_SAVED_ARRAYS = {
+    "vertices": ("f", (3,)), "triangles": ("iu", (3,)), "normals": ("f", (3, 3)),
+    "uvs": ("f", (3, 2)), "material_index": ("iu", ()), "object_index": ("iu", ()),
+    "meta": ("u", ()),
+}
+MAX_META_BYTES = 64 << 20
+
+
+def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
+    """The saved arrays, after checking every header (dtype, shape, total size)."""
+    headers = {}
+    for name, (kinds, trailing) in _SAVED_ARRAYS.items():
+        with archive.open(f"{name}.npy") as f:
+            version = np.lib.format.read_magic(f)
+            read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
+                           else np.lib.format.read_array_header_2_0)
+            shape, _fortran, dtype = read_header(f)
+        if dtype.kind not in kinds or dtype.hasobject or tuple(shape[1:]) != trailing \
+                or len(shape) != 1 + len(trailing):
+            raise SceneError(f"{path}: array {name!r} has dtype {dtype} and shape {shape}")
+        headers[name] = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+    if headers["meta"] > MAX_META_BYTES:
+        raise SceneError(f"{path}: its description block is {headers['meta']} bytes")
+    total = sum(headers.values())
+    free = memory.available()
+    if free is not None and total > free // 2:
+        raise SceneError(f"{path}: its arrays need {total / memory.GIB:.2f} GiB once decompressed, "
+                         f"more than half the {free / memory.GIB:.2f} GiB of memory available")
+    with np.load(path, allow_pickle=False) as z:
+        return {name: z[name] for name in _SAVED_ARRAYS}
+
+
+def _from_saved(z: dict, meta: dict) -> "SceneDescription":
+    """Build the description from the arrays and the JSON metadata of a saved file."""
+    geom = Geometry(vertices=z["vertices"], triangles=z["triangles"], normals=z["normals"],
+                    uvs=z["uvs"], material_index=z["material_index"],
+                    object_index=z["object_index"], object_names=list(meta["object_names"]))
+    lights = []
+    for d in meta["lights"]:
+        d = dict(d)
+        d["matrix_world"] = np.array(d["matrix_world"], float)
+        lights.append(Light(**{k: (tuple(v) if isinstance(v, list) and k != "matrix_world" else v)
+                               for k, v in d.items()}))
+    cam = dict(meta["camera"])
+    cam["matrix_world"] = np.array(cam["matrix_world"], float)
+    film = dict(meta["film"])
+    if film.get("region") is not None:
+        film["region"] = tuple(film["region"])
+    return SceneDescription(
+        geometry=geom,
+        materials=[Material(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in d.items()})
+                   for d in meta["materials"]],
+        lights=lights, camera=Camera(**cam),
+        world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
+        film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
+        warnings=list(meta.get("warnings", [])))
 
 
 def _plain(d: dict) -> dict:
@@ -392,3 +470,32 @@ def _integrator_meta(d: dict) -> dict:
     if "method" in d:
         d["name"] = d.pop("method")
     return d
+
+
+def _check_number(where: str, name: str, value, lo=None, hi=None) -> None:
+    """SceneError unless ``value`` is a finite number within [lo, hi]."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise SceneError(f"{where}: {name} must be a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise SceneError(f"{where}: {name} must be finite, got {value!r}")
+    if (lo is not None and x < lo) or (hi is not None and x > hi):
+        bounds = f"at least {lo}" if hi is None else f"between {lo} and {hi}" if lo is not None \
+            else f"at most {hi}"
+        raise SceneError(f"{where}: {name} must be {bounds}, got {value!r}")
+
+
+def _check_vector(where: str, name: str, value, size: int) -> None:
+    v = np.asarray(value, float) if np.ndim(value) == 1 else None
+    if v is None or v.shape != (size,) or not np.all(np.isfinite(v)):
+        raise SceneError(f"{where}: {name} must be {size} finite values, got {value!r}")
+
+
+def _check_matrix(where: str, value, axes: bool = False) -> None:
+    """A finite 4x4 matrix; with ``axes``, its three axes must have a length (they are normalised)."""
+    m = np.asarray(value, float)
+    if m.shape != (4, 4) or not np.all(np.isfinite(m)):
+        raise SceneError(f"{where}: matrix_world must be a finite 4x4 matrix")
+    if axes and np.any(np.linalg.norm(m[:3, :3], axis=0) <= 0.0):
+        raise SceneError(f"{where}: matrix_world has a zero-length axis (scale 0)")

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import memory
 from .adaptive import Adaptive
 from .film import Film
 from .integrators import get as integrator_info
@@ -143,6 +144,11 @@ class _Buffers:
             self.acc = np.zeros((batch, 4))
             self.root_pixel = np.zeros(batch, np.int32)
 
+    @staticmethod
+    def bytes_for(batch, classic) -> int:
+        """Memory of one worker's buffers for ``batch`` paths (without allocating them)."""
+        return batch * _Buffers(1, classic).nbytes
+
     @property
     def nbytes(self) -> int:
         arrays = [*self.state, *self.shadow]
@@ -184,7 +190,7 @@ class RenderSession:
     """A render of one scene description; see the module docstring."""
 
     def __init__(self, scene: SceneDescription, *, threads: int | None = None,
-                 batch_size: int | None = None):
+                 batch_size: int | None = None, host_bytes_per_pixel: int = 0):
         self.scene = scene.validate()
         self.threads = int(threads or default_threads())
         self.batch_size = int(batch_size or DEFAULT_BATCH)
@@ -194,6 +200,7 @@ class RenderSession:
         self.integrator = integrator_info(it.name)
         self._classic_setup()
         x0, y0, x1, y1 = scene.film.window
+        self._check_memory((x1 - x0) * (y1 - y0), host_bytes_per_pixel)
         self.film = Film(x1 - x0, y1 - y0)
         self.adaptive = Adaptive.from_settings(it)
         self.active = np.arange(self.film.count.size, dtype=np.int32)
@@ -216,9 +223,9 @@ class RenderSession:
         """Samples of the pixels still being sampled (converged pixels stopped earlier)."""
         return self.pass_samples if self.pass_samples else self.film.samples_min()
 
-    def image(self) -> np.ndarray:
-        """(h, w, 4) float32 linear RGBA of the film region, top row first."""
-        return self.film.image(self.scene.film.exposure)
+    def image(self, bottom_up: bool = False) -> np.ndarray:
+        """(h, w, 4) float32 linear RGBA of the film region, top row first (or last)."""
+        return self.film.image(self.scene.film.exposure, bottom_up)
 
     def variance(self) -> np.ndarray:
         """(h, w, 3) float32 variance of each pixel's mean (inf below 2 samples)."""
@@ -304,6 +311,17 @@ class RenderSession:
                 f"level per camera sample exceed the batch of {self.batch_size}; lower the depth"
                 + (" or the branching" if self.integrator.uses_branching else ""))
         self.roots_per_chunk = max(1, self.batch_size // widest)
+
+    def _check_memory(self, pixels: int, host_bytes_per_pixel: int) -> None:
+        """SceneError, with the figures, if the render cannot fit in the memory left."""
+        need = memory.estimate(pixels, self.scene.geometry.num_triangles,
+                               self.threads * _Buffers.bytes_for(self.batch_size, self._classic),
+                               host_bytes_per_pixel)
+        free = memory.available()
+        if free is not None and need.total > free:
+            raise SceneError(f"not enough memory: this render needs {need.describe()}, "
+                             f"{free / memory.GIB:.2f} GiB are available; lower the resolution "
+                             f"or render a region")
 
     def _stopping(self, should_stop, t_start, time_limit) -> bool:
         if self._stop.is_set():

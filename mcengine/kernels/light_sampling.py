@@ -24,7 +24,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device
-from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_COS, L_TYPE, LF_CAST_SHADOW, LF_USE_MIS,
+from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_OMC, L_TYPE, LF_CAST_SHADOW, LF_USE_MIS,
                      LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY, LF_VIS_TRANSMISSION, LT_SUN,
                      intersect_lamp, lamp_importance, sample_lamp, sun_radiance)
 from .materials import M_EMISSION
@@ -226,7 +226,7 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_to
     """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
     r = g = b = 0.0
     for li in range(lamps.shape[0]):
-        if int(lamps[li, L_TYPE]) != LT_SUN or lamps[li, L_SUN_COS] >= 1.0:
+        if int(lamps[li, L_TYPE]) != LT_SUN or lamps[li, L_SUN_OMC] <= 0.0:
             continue
         lflags = int(lamps[li, L_FLAGS])
         if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):

@@ -60,7 +60,7 @@ L_AREA = 21          # area of the emitting surface
 L_SPOT_COS = 22      # cos(spot_size / 2)
 L_SPOT_SMOOTH = 23   # 1 / ((1 - cos) * blend), 0 for a hard edge
 L_SPOT_INV = 24      # 9: world-to-local 3x3 of the spot (rows), scale included
-L_SUN_COS = 33       # cos(angle / 2); 1 for a delta sun
+L_SUN_OMC = 33       # 1 - cos(angle / 2), computed without cancellation; 0 for a delta sun
 L_SPREAD_TAN = 34    # tan(spread / 2); negative: no spread attenuation
 L_SPREAD_NORM = 35   # 1 / (tan(spread/2) - spread/2)
 L_FLAGS = 36
@@ -68,6 +68,15 @@ L_MAX_BOUNCES = 37
 L_PMF = 38           # probability of picking this lamp for NEE (by power, scene-wide)
 L_IMPORTANCE = 39    # scale of the irradiance estimate that picks lights per shading point
 LIGHT_STRIDE = 40
+
+# A light that subtends a cone with 1 - cos(half angle) below this is a delta
+# light (a direction, or a point): its cone would be narrower than 1.4e-7 rad,
+# which no image can tell from a delta, and below about 1e-16 the cone cannot
+# be represented at all.  Both forms give the same irradiance; the choice is
+# made here, from this one quantity, for sampling, intersection and radiance.
+DELTA_CONE_OMC = 1e-14
+# Lamp radii below this are 0: their radiance P / (4 pi^2 r^2) would overflow.
+MIN_LAMP_RADIUS = 1e-60
 
 # Per-point light selection never gives a light less than this share of its
 # unattenuated weight where it might still contribute (spot edges with a
@@ -121,10 +130,11 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
         flags |= LF_VIS_TRANSMISSION if li.visible_transmission else 0
         row[L_MAX_BOUNCES] = li.max_bounces
         row[L_SPREAD_TAN] = -1.0
-        row[L_SUN_COS] = 1.0
+        # Negative strengths remove light, as in Cycles; lights are picked by |strength|.
+        magnitude = float(np.abs(strength).mean())
         if li.type in ("POINT", "SPOT"):
             row[L_TYPE] = LT_POINT if li.type == "POINT" else LT_SPOT
-            r = max(float(li.radius), 0.0)
+            r = float(li.radius) if li.radius >= MIN_LAMP_RADIUS else 0.0
             row[L_RADIUS] = r
             row[L_DISK] = 1.0 if li.soft_falloff else 0.0
             if r > 0.0:
@@ -132,8 +142,8 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 row[L_RADIANCE:L_RADIANCE + 3] = strength / (4.0 * math.pi * math.pi * r * r)
             else:
                 row[L_RADIANCE:L_RADIANCE + 3] = strength / (4.0 * math.pi)
-            power[i] = strength.mean()
-            row[L_IMPORTANCE] = strength.mean() / (4.0 * math.pi)
+            power[i] = magnitude
+            row[L_IMPORTANCE] = magnitude / (4.0 * math.pi)
             if li.type == "SPOT":
                 c = math.cos(0.5 * float(li.spot_size))
                 row[L_SPOT_COS] = c
@@ -145,14 +155,16 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 power[i] *= max(0.5 * (1.0 - c), 1e-3)
         elif li.type == "SUN":
             row[L_TYPE] = LT_SUN
-            half = 0.5 * float(li.angle)
-            if half > 0.0:
-                row[L_SUN_COS] = math.cos(half)
-                row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * math.sin(half) ** 2)
+            half = 0.5 * min(max(float(li.angle), 0.0), math.pi)
+            omc = 2.0 * math.sin(0.5 * half) ** 2          # 1 - cos(half)
+            if omc > DELTA_CONE_OMC:
+                row[L_SUN_OMC] = omc
+                # pi sin^2(half) from the stored quantity, so that L / pdf is exactly S.
+                row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * omc * (2.0 - omc))
             else:
                 row[L_RADIANCE:L_RADIANCE + 3] = strength
-            power[i] = strength.mean() * math.pi * scene_radius ** 2
-            row[L_IMPORTANCE] = strength.mean()
+            power[i] = magnitude * math.pi * scene_radius ** 2
+            row[L_IMPORTANCE] = magnitude
         elif li.type == "AREA":
             row[L_TYPE] = LT_AREA
             sx = float(li.size_x)
@@ -166,7 +178,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
             if area > 0.0:
                 norm_area = area if li.normalize else 1.0
                 row[L_RADIANCE:L_RADIANCE + 3] = strength / (math.pi * norm_area)
-                power[i] = strength.mean() * (1.0 if li.normalize else area)
+                power[i] = magnitude * (1.0 if li.normalize else area)
                 row[L_IMPORTANCE] = power[i] / math.pi
             spread = float(li.spread)
             if spread < math.pi - 1e-6:
@@ -174,8 +186,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 row[L_SPREAD_TAN] = math.tan(half)
                 row[L_SPREAD_NORM] = _spread_normalisation(half)
         row[L_FLAGS] = flags
-    table[:, L_IMPORTANCE] = np.maximum(table[:, L_IMPORTANCE], 0.0)
-    return table, np.maximum(power, 0.0)
+    return table, power
 
 
 @device
@@ -290,16 +301,16 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
     typ = int(lamps[li, L_TYPE])
     if typ == LT_SUN:
         azx, azy, azz = lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2]
-        cos_max = lamps[li, L_SUN_COS]
-        if cos_max >= 1.0:
+        omc = lamps[li, L_SUN_OMC]
+        if omc <= 0.0:
             return azx, azy, azz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], 0.0
-        x, y, z = uniform_cone(u1, u2, cos_max)
+        x, y, z = uniform_cone(u1, u2, omc)
         tx, ty, tz, bx, by, bz = orthonormal_basis(azx, azy, azz)
         wx = x * tx + y * bx + z * azx
         wy = x * ty + y * by + z * azy
         wz = x * tz + y * bz + z * azz
         return (wx, wy, wz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2],
-                uniform_cone_pdf(cos_max))
+                uniform_cone_pdf(omc))
 
     cx, cy, cz = lamps[li, L_POS], lamps[li, L_POS + 1], lamps[li, L_POS + 2]
     if typ == LT_AREA:
@@ -353,16 +364,18 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
     if d == 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
     nx, ny, nz = dx / d, dy / d, dz / d
-    if r <= 0.0:
-        # Delta light: return intensity / d^2 as the L/pdf term.
+    if r > 0.0 and d <= r:
+        return nx, ny, nz, d, 0.0, 0.0, 0.0, 0.0   # inside the lamp: no defined direction
+    omc = lamp_cone_omc(r, d2)
+    if omc <= DELTA_CONE_OMC:
+        # A point: return intensity / d^2 as the L/pdf term (intensity P / (4 pi)
+        # is the sphere's or disk's radiance times pi r^2).
         att = 1.0
         if typ == LT_SPOT:
             att = spot_attenuation(lamps, li, -nx, -ny, -nz)
-        k = att / d2
+        k = att / d2 if r <= 0.0 else att * math.pi * r * r / d2
         return (nx, ny, nz, d, k * lamps[li, L_RADIANCE], k * lamps[li, L_RADIANCE + 1],
                 k * lamps[li, L_RADIANCE + 2], 0.0)
-    if d <= r:
-        return nx, ny, nz, d, 0.0, 0.0, 0.0, 0.0   # inside the lamp: no defined direction
     if lamps[li, L_DISK] > 0.0:
         # Disk of radius r through the centre, facing p.
         a, b = disk_concentric(u1, u2)
@@ -380,9 +393,7 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         pdf = q2 / (math.pi * r * r * cos_l)
     else:
         # Sphere: uniform over the cone of directions it subtends.
-        sin2 = r * r / d2
-        cos_max = math.sqrt(max(0.0, 1.0 - sin2))
-        x, y, z = uniform_cone(u1, u2, cos_max)
+        x, y, z = uniform_cone(u1, u2, omc)
         tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
         wx = x * tx + y * bx + z * nx
         wy = x * ty + y * by + z * ny
@@ -391,12 +402,26 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         b_ = d * z
         disc = r * r - (d2 - b_ * b_)
         dist = b_ - math.sqrt(max(disc, 0.0))
-        pdf = uniform_cone_pdf(cos_max)
+        pdf = uniform_cone_pdf(omc)
     att = 1.0
     if typ == LT_SPOT:
         att = spot_attenuation(lamps, li, -wx, -wy, -wz)
     return (wx, wy, wz, dist, att * lamps[li, L_RADIANCE], att * lamps[li, L_RADIANCE + 1],
             att * lamps[li, L_RADIANCE + 2], pdf)
+
+
+@device
+def lamp_cone_omc(r, d2):
+    """1 - cos of the half angle a lamp of radius r subtends at distance^2 d2 (0 for r = 0).
+
+    The sphere's cone has sin^2 = r^2 / d^2, and 1 - cos = sin^2 / (1 + cos),
+    free of cancellation.  The facing disk gets the same measure, so both
+    forms turn into a point at the same distance (``DELTA_CONE_OMC``).
+    """
+    sin2 = r * r / d2
+    if sin2 >= 1.0:
+        return 1.0
+    return sin2 / (1.0 + math.sqrt(1.0 - sin2))
 
 
 @device
@@ -444,8 +469,8 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
         return math.inf, 0.0, 0.0, 0.0, 0.0
     px, py, pz = cx - ox, cy - oy, cz - oz
     d2 = px * px + py * py + pz * pz
-    if d2 <= r * r:
-        return math.inf, 0.0, 0.0, 0.0, 0.0
+    if d2 <= r * r or lamp_cone_omc(r, d2) <= DELTA_CONE_OMC:
+        return math.inf, 0.0, 0.0, 0.0, 0.0   # inside, or a point from here: rays miss it
     d = math.sqrt(d2)
     if lamps[li, L_DISK] > 0.0:
         # Disk through the centre facing the ray origin.
@@ -468,7 +493,7 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
         t = b_ - math.sqrt(disc)
         if t <= 0.0 or t >= tmax:
             return math.inf, 0.0, 0.0, 0.0, 0.0
-        pdf = uniform_cone_pdf(math.sqrt(max(0.0, 1.0 - r * r / d2)))
+        pdf = uniform_cone_pdf(lamp_cone_omc(r, d2))
     att = 1.0
     if typ == LT_SPOT:
         att = spot_attenuation(lamps, li, -dx, -dy, -dz)
@@ -478,9 +503,9 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
 @device
 def sun_radiance(lamps, li, dx, dy, dz):
     """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d."""
-    cos_max = lamps[li, L_SUN_COS]
-    if cos_max >= 1.0:
+    omc = lamps[li, L_SUN_OMC]
+    if omc <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
-    if dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2] < cos_max:
+    if 1.0 - (dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2]) > omc:
         return 0.0, 0.0, 0.0, 0.0
-    return lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], uniform_cone_pdf(cos_max)
+    return lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], uniform_cone_pdf(omc)

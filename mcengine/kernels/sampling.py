@@ -108,13 +108,14 @@ def cosine_hemisphere(u1, u2):
 
 
 @device
-def uniform_cone(u1, u2, cos_max):
-    """Direction around +z, uniform over the cap cos(theta) >= cos_max.
+def uniform_cone(u1, u2, omc):
+    """Direction around +z, uniform over the cap 1 - cos(theta) <= omc.
 
-    The density is 1/(2 pi (1 - cos_max)) per steradian.  ``1 - cos`` is
-    carried as ``(1 - cos_max) * u1`` so tiny cones stay accurate.
+    The cap is given by ``omc`` = 1 - cos(half angle) rather than the cosine,
+    which rounds to 1 for cones below about 1e-8 rad; its density is
+    1/(2 pi omc) per steradian (:func:`uniform_cone_pdf`).
     """
-    one_minus = (1.0 - cos_max) * u1
+    one_minus = omc * u1
     z = 1.0 - one_minus
     sin2 = one_minus * (2.0 - one_minus)
     r = math.sqrt(max(0.0, sin2))
@@ -123,8 +124,9 @@ def uniform_cone(u1, u2, cos_max):
 
 
 @device
-def uniform_cone_pdf(cos_max):
-    return 1.0 / (2.0 * math.pi * (1.0 - cos_max))
+def uniform_cone_pdf(omc):
+    """Density of :func:`uniform_cone` per steradian (omc > 0)."""
+    return 1.0 / (2.0 * math.pi * omc)
 
 
 @device

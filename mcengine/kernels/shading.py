@@ -106,6 +106,8 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
             ex, ey, ez = offset_origin(ex, ey, ez, lnx, lny, lnz, -wix, -wiy, -wiz)
         sdx, sdy, sdz = ex - sox, ey - soy, ez - soz
         length = math.sqrt(sdx * sdx + sdy * sdy + sdz * sdz)
+        if not length > 0.0:
+            return n_shadow   # the light point is where the ray starts: no direction to test
         sdx, sdy, sdz = sdx / length, sdy / length, sdz / length
         tmax = length * (1.0 - SHADOW_SHORTEN)
     sq.o32[n_shadow, 0], sq.o32[n_shadow, 1], sq.o32[n_shadow, 2] = sox, soy, soz
@@ -163,7 +165,7 @@ def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, f
     if sc.lamps.shape[0]:
         lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
                                mpx, mpy, mpz, mis_total)
-        if lr + lg + lb > 0.0:
+        if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
                       stats)
     return transparent_film
@@ -208,7 +210,8 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, id
     ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
                       sc.mat_index, sc.materials, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
     wix, wiy, wiz = ls.wix, ls.wiy, ls.wiz
-    if ls.lr + ls.lg + ls.lb <= 0.0 or wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz <= 0.0:
+    no_light = ls.lr == 0.0 and ls.lg == 0.0 and ls.lb == 0.0   # (lights may be negative)
+    if no_light or wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz <= 0.0:
         return n_shadow
     fr_, fg_, fb_, bsdf_pdf = bsdf_eval(
         sc.materials, m, fr.wox, fr.woy, fr.woz, wix * fr.tx + wiy * fr.ty + wiz * fr.tz,
@@ -218,7 +221,7 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, id
     cr = beta[i, 0] * fr_ * ls.lr * w
     cg = beta[i, 1] * fg_ * ls.lg * w
     cb = beta[i, 2] * fb_ * ls.lb * w
-    if cr + cg + cb <= 0.0:
+    if cr == 0.0 and cg == 0.0 and cb == 0.0:
         return n_shadow
     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)

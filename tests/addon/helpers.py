@@ -78,8 +78,8 @@ class GradientSession:
                 on_pass(self)
         return self
 
-    def image(self):
-        return self._image.copy()
+    def image(self, bottom_up=False):
+        return (self._image[::-1] if bottom_up else self._image).copy()
 
 
 def export_scene(sessions):

@@ -14,13 +14,6 @@ from .expect import render
 from .scenes import inside_sphere_scene
 
 
-def test_core_never_imports_blender():
-    code = ("import sys, mcengine, mcengine.session, mcengine.compare, mcengine.imageio;"
-            "print(any(m in sys.modules for m in ('bpy', 'mathutils')))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "False"
-
-
 def test_saved_scene_renders_identically(tmp_path):
     scene = inside_sphere_scene(albedo=0.6, emission=0.4, samples=4, res=8)
     scene.warnings.append("example warning")

@@ -90,7 +90,11 @@ def bsdf_sample(mats, m, wox, woy, woz, backfacing, u_lobe, u1, u2):
                     mats[m, M_GLASS + 2] * k, 0.0, LABEL_REFLECT | LABEL_SINGULAR)
         return (-wox / eta, -woy / eta, -cos_t, mats[m, M_GLASS] * k, mats[m, M_GLASS + 1] * k,
                 mats[m, M_GLASS + 2] * k, 0.0, LABEL_TRANSMIT | LABEL_SINGULAR)
-    k = total / mats[m, M_W_REFRACT]
+    wr = mats[m, M_W_REFRACT]
+    if wr <= 0.0:
+        # Rounding carried u past the last lobe with weight: no sample.
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+    k = total / wr
     f, cos_t = fresnel_dielectric(woz, eta)
     if cos_t <= 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE   # total internal reflection

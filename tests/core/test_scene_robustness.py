@@ -1,0 +1,167 @@
+"""Bad scene data gets a SceneError naming the problem, never a crash or a wrong image.
+
+Covers what ``SceneDescription.validate`` must refuse (non-finite or out-of-range
+values anywhere), what ``SceneDescription.load`` must survive (truncated,
+foreign and crafted ``.npz`` files, including one that would decompress to
+gigabytes), and the memory check that refuses a render too large to fit
+before any work is done.
+"""
+from __future__ import annotations
+
+import io
+import math
+import zipfile
+
+import numpy as np
+import pytest
+
+from mcengine import memory
+from mcengine.film import Film
+from mcengine.scene import Light, SceneDescription, SceneError
+from mcengine.session import RenderSession, _Buffers
+
+from .scenes import inside_sphere_scene, plane_scene, translation
+
+
+def _scene():
+    return plane_scene(Light(type="POINT", matrix_world=translation(0, 0, 2), strength=(100,) * 3))
+
+
+NAN, INF = math.nan, math.inf
+
+
+@pytest.mark.parametrize("where,attr,value", [
+    ("film", "width", 10 ** 6), ("film", "exposure", NAN), ("film", "filter_width", 0.0),
+    ("film", "pixel_aspect_x", 0.0), ("world", "color", (NAN, 0, 0)),
+    ("world", "color", (INF, 0, 0)), ("camera", "lens", NAN), ("camera", "clip_end", INF),
+    ("camera", "matrix_world", np.diag([0.0, 1, 1, 1])), ("camera", "sensor_fit", "DIAGONAL"),
+    ("light", "radius", NAN), ("light", "radius", INF), ("light", "angle", NAN),
+    ("light", "size_x", -1.0), ("light", "spot_size", 4.0), ("light", "spread", NAN),
+    ("integrator", "samples", 1 << 30), ("integrator", "clamp_direct", NAN),
+    ("integrator", "time_limit", -1.0),
+])
+def test_validation_refuses_non_finite_and_out_of_range_values(where, attr, value):
+    scene = _scene()
+    target = scene.lights[0] if where == "light" else getattr(scene, where)
+    setattr(target, attr, value)
+    with pytest.raises(SceneError, match=attr):
+        scene.validate()
+
+
+def _saved(tmp_path, scene=None) -> bytes:
+    path = tmp_path / "scene.npz"
+    (scene or inside_sphere_scene(samples=1, res=4)).save(path)
+    return path.read_bytes()
+
+
+def _replace_member(data: bytes, name: str, payload: bytes) -> bytes:
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, payload if info.filename == name else src.read(info))
+    return out.getvalue()
+
+
+def _npy(array) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, array)
+    return buf.getvalue()
+
+
+def _load(tmp_path, data: bytes):
+    path = tmp_path / "crafted.npz"
+    path.write_bytes(data)
+    return SceneDescription.load(path)
+
+
+@pytest.mark.parametrize("case", ["truncated", "missing member", "meta not json", "meta wrong type",
+                                  "unknown field", "wrong dtype", "wrong shape", "bad indices",
+                                  "nan vertices", "not a zip"])
+def test_loading_a_damaged_file_is_a_scene_error(tmp_path, case):
+    data = _saved(tmp_path)
+    if case == "truncated":
+        data = data[:len(data) // 2]
+    elif case == "missing member":
+        out = io.BytesIO()
+        with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w") as dst:
+            for info in src.infolist():
+                if info.filename != "normals.npy":
+                    dst.writestr(info.filename, src.read(info))
+        data = out.getvalue()
+    elif case == "meta not json":
+        data = _replace_member(data, "meta.npy", _npy(np.frombuffer(b"{oops", np.uint8)))
+    elif case == "meta wrong type":
+        data = _replace_member(data, "meta.npy", _npy(np.frombuffer(b'{"lights": 3}', np.uint8)))
+    elif case == "unknown field":
+        z = np.load(io.BytesIO(data))
+        meta = bytes(z["meta"]).decode().replace('"name": "Light"', '"name": "Light", "bogus": 1')
+        meta = meta.replace('"samples":', '"colour": 1, "samples":')
+        data = _replace_member(data, "meta.npy", _npy(np.frombuffer(meta.encode(), np.uint8)))
+    elif case == "wrong dtype":
+        data = _replace_member(data, "triangles.npy", _npy(np.array([["a", "b", "c"]])))
+    elif case == "wrong shape":
+        data = _replace_member(data, "vertices.npy", _npy(np.zeros((4, 2), np.float32)))
+    elif case == "bad indices":
+        z = np.load(io.BytesIO(data))
+        data = _replace_member(data, "triangles.npy", _npy(z["triangles"] + 10 ** 6))
+    elif case == "nan vertices":
+        z = np.load(io.BytesIO(data))
+        data = _replace_member(data, "vertices.npy", _npy(z["vertices"] * np.nan))
+    else:
+        data = b"PK\x03\x04 but not really a zip file"
+    with pytest.raises(SceneError):
+        _load(tmp_path, data)
+
+
+def test_loading_refuses_a_file_that_would_not_fit_in_memory(tmp_path, monkeypatch):
+    """A 1 MB crafted file that decompresses to gigabytes: refused from the array headers
+    alone, before anything is decompressed."""
+    data = _saved(tmp_path)
+    big = np.zeros((200_000_000, 3), np.float32)   # 2.4 GB of zeros, ~2 MB deflated
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        with z.open("vertices.npy", "w", force_zip64=True) as f:
+            np.lib.format.write_array_header_1_0(f, np.lib.format.header_data_from_array_1_0(big))
+            chunk = bytes(1 << 24)
+            for _ in range(big.nbytes // len(chunk)):
+                f.write(chunk)
+        with zipfile.ZipFile(io.BytesIO(data)) as src:
+            for info in src.infolist():
+                if info.filename != "vertices.npy":
+                    z.writestr(info.filename, src.read(info))
+    assert len(buf.getvalue()) < 5 << 20
+    monkeypatch.setattr(memory, "available", lambda: 1 << 30)
+    with pytest.raises(SceneError, match="memory"):
+        _load(tmp_path, buf.getvalue())
+
+
+def test_a_render_that_cannot_fit_is_refused_before_any_work(monkeypatch):
+    scene = _scene()
+    scene.film.width = scene.film.height = 16384
+    monkeypatch.setattr(memory, "available", lambda: 5 << 30)
+    with pytest.raises(SceneError, match=r"not enough memory: this render needs about 2\d\.\d\d GiB"):
+        RenderSession(scene)
+
+
+def test_memory_estimate_counts_what_a_render_allocates():
+    scene = _scene()
+    scene.film.width, scene.film.height = 640, 480
+    session = RenderSession(scene, threads=2).run()
+    film_arrays = sum(a.nbytes for a in session.film.arrays)
+    assert memory.estimate(640 * 480, 0, 0).film == film_arrays + session.active.nbytes
+    # bytes_for (used before allocating) equals what the two workers allocated.
+    assert session.buffer_bytes - film_arrays == 2 * _Buffers.bytes_for(session.batch_size, False)
+
+
+def test_film_read_out_is_exact_and_flips_without_copies():
+    film = Film(5, 70_000 // 5 + 3)          # more than one read-out block
+    rng = np.random.default_rng(1)
+    film.sum[:] = rng.random(film.sum.shape)
+    film.count[:] = rng.integers(0, 4, film.count.size)
+    expect = (film.sum / np.maximum(film.count, 1)[:, None]).astype(np.float32)
+    expect[:, :3] = (film.sum[:, :3] / np.maximum(film.count, 1)[:, None] * 2.0).astype(np.float32)
+    img = film.image(2.0)
+    np.testing.assert_array_equal(img.reshape(-1, 4), expect)
+    flipped = film.image(2.0, bottom_up=True)
+    assert flipped.flags.c_contiguous
+    np.testing.assert_array_equal(flipped, img[::-1])

@@ -186,6 +186,9 @@ def stats_line(done: int, total: int, stats, pixels: int = 0) -> str:
     eta = getattr(stats, "eta_seconds", None)
     if eta is not None and math.isfinite(eta):
         parts.append(f"Remaining {_clock(eta)}")
+    nonfinite = getattr(stats, "nonfinite", 0)
+    if nonfinite:
+        parts.append(f"{nonfinite:,} non-finite samples dropped")
     return " | ".join(parts)
 
 

@@ -94,14 +94,18 @@ class RenderStats:
                 "render": self.time_render}
 
     def accounting(self, pixels: int, time_export: float = 0.0) -> str:
-        """One line: rays per pixel by kind, Mrays/s, time per phase."""
+        """One line: rays per pixel by kind, Mrays/s, time per phase, and the count of
+        non-finite samples dropped when there were any (so a bug cannot hide behind the guard)."""
         r = self.rays_per_pixel(pixels)
         t = self.phases(time_export)
-        return (f"rays/pixel: camera {r['camera']:.1f}, bounce {r['bounce']:.1f}, "
+        line = (f"rays/pixel: camera {r['camera']:.1f}, bounce {r['bounce']:.1f}, "
                 f"shadow {r['shadow']:.1f} | {self.rays_per_second / 1e6:.2f} Mrays/s | "
                 f"export {t['export']:.2f} s, BVH {t['bvh']:.2f} s, kernels {t['kernels']:.2f} s, "
                 f"tracing {t['tracing']:.2f} s, shading {t['shading']:.2f} s (thread-seconds), "
                 f"wall {t['render']:.2f} s")
+        if self.nonfinite:
+            line += f" | {self.nonfinite:,} non-finite samples dropped"
+        return line
 
 
 class _TimedAccel:

@@ -46,6 +46,10 @@ def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
         ctx.warn(f"light '{name}' is a light portal: portals are not supported yet; skipped "
                  f"(portals add no light, only less noise, in Cycles)", "light portals")
         return None
+    strength = _strength(ctx, data, name)
+    if not np.all(np.isfinite(strength)):
+        ctx.warn(f"light '{name}': strength {strength} is not finite; skipped", "non-finite light")
+        return None
     s = ctx.unit_scale
     matrix = np.array(matrix_world, np.float64)
     matrix[:3, 3] *= s
@@ -53,7 +57,7 @@ def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
         type=data.type,
         name=name,
         matrix_world=matrix,
-        strength=_strength(ctx, data, name),
+        strength=strength,
         normalize=bool(data.normalize),
         cast_shadow=bool(data.use_shadow),
         use_mis=bool(cycles.use_multiple_importance_sampling) if cycles is not None else True,

@@ -9,6 +9,8 @@ node tree uses ``world.color``; no world at all is black.
 """
 from __future__ import annotations
 
+import math
+
 from mcengine.scene import World
 
 from .materials import clamp_color, fmt, linked_node
@@ -29,7 +31,12 @@ def export_world(ctx, world) -> World:
     if hidden:
         ctx.warn(f"world '{world.name}': ray visibility ({', '.join(hidden)} off) not supported "
                  f"yet; the world lights everything", "world ray visibility")
-    return World(color=_world_color(ctx, world), visible_camera=bool(visibility.camera))
+    color = _world_color(ctx, world)
+    if not all(math.isfinite(c) for c in color):
+        ctx.warn(f"world '{world.name}': background {fmt(color)} is not finite; rendered black",
+                 "non-finite world")
+        color = BLACK
+    return World(color=color, visible_camera=bool(visibility.camera))
 
 
 def _world_color(ctx, world) -> tuple:

@@ -130,3 +130,14 @@ def test_unit_scale_converts_lengths_and_keeps_irradiance(scene, fake_session):
     # Power x scale^2: the same irradiance as Cycles, which ignores the unit scale.
     assert bulb.strength == pytest.approx((0.01, 0.01, 0.01)) == panel.strength
     assert not [w for w in desc.warnings if "unit scale" in w]
+
+
+def test_negative_lamps_are_kept_and_non_finite_ones_skipped_with_a_warning(scene, fake_session):
+    """Cycles renders negative lamps as negative light (the core does too); a lamp whose
+    strength is not finite is skipped, with a warning naming it."""
+    lamp(scene, "POINT", name="Sink", energy=-100.0)
+    lamp(scene, "POINT", name="Broken", energy=math.inf)
+    desc = export_scene(fake_session)
+    assert [li.name for li in desc.lights] == ["Sink"]
+    assert desc.lights[0].strength == pytest.approx((-100, -100, -100))
+    assert any("'Broken'" in w and "not finite" in w for w in desc.warnings)

@@ -120,6 +120,13 @@ def test_world_background(scene, fake_session):
     assert not any(w.startswith("world") for w in desc.warnings)
 
 
+def test_non_finite_world_is_black_with_a_warning(scene, fake_session):
+    world_with_background((0.2, 0.4, 0.6), float("nan"))
+    desc = export_scene(fake_session)
+    assert desc.world.color == (0, 0, 0)
+    assert any(w.startswith("world 'Sky'") and "not finite" in w for w in desc.warnings)
+
+
 def test_no_world_is_black(scene, fake_session):
     scene.world = None
     assert export_scene(fake_session).world.color == (0, 0, 0)

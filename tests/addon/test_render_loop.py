@@ -167,3 +167,5 @@ def test_stats_line(addon):
     assert line(1, 64, SimpleNamespace(rays_per_second=0.0, eta_seconds=float("nan"))) == "Sample 1/64"
     assert line(2, 8, object()) == "Sample 2/8"
     assert line(2, 8, SimpleNamespace(eta_seconds=3725)) == "Sample 2/8 | Remaining 1:02:05"
+    assert line(2, 8, SimpleNamespace(nonfinite=12345)) == \
+        "Sample 2/8 | 12,345 non-finite samples dropped"

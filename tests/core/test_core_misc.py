@@ -89,3 +89,11 @@ def test_blackman_harris_table_matches_cycles_edge_profile():
         assert abs((off > 1).mean() - one) < 0.003
         if two is not None:
             assert abs((off > 2).mean() - two) < 0.002
+
+
+def test_accounting_names_dropped_non_finite_samples_only_when_there_are_some():
+    from mcengine.session import RenderStats
+    stats = RenderStats(camera_rays=100, time_render=1.0)
+    assert "non-finite" not in stats.accounting(10)
+    stats.nonfinite = 1234
+    assert stats.accounting(10).endswith(" | 1,234 non-finite samples dropped")

@@ -5,33 +5,30 @@ the engine reads ``scene.cycles`` for those (see ``export.settings``).
 """
 # No "from __future__ import annotations": bpy reads the property annotations as objects.
 import bpy
+from mcengine import integrators
 
 __all__ = ["MCEngineSceneSettings", "register", "unregister"]
 
-
-INTEGRATORS = [
-    ("PATH", "Path Tracing", "One secondary ray per bounce, light sampling with multiple "
-     "importance sampling, Russian roulette; matches Cycles", 0),
-    ("RAYCAST", "Ray Casting", "Camera rays and direct light from every light; no reflected "
-     "light: fast and biased", 1),
-    ("WHITTED", "Whitted", "Direct light plus perfect mirror and refraction rays down to Depth "
-     "ray levels: 2^depth - 1 rays per sample at most", 2),
-    ("DISTRIBUTION", "Distribution", "Direct light plus Branching rays at every hit down to Depth "
-     "ray levels: 1 + b + ... + b^(depth-1) rays per sample", 3),
-]
+# The integrator enum's items, from the registry.  A .blend stores the index, so new
+# integrators go at the end of the registry.
+INTEGRATOR_ITEMS = [(info.enum_id, info.label, info.description, index)
+                    for index, info in enumerate(integrators.INTEGRATORS.values())]
 
 
 class MCEngineSceneSettings(bpy.types.PropertyGroup):
     """Per-scene MC Engine settings that Cycles has no equivalent for."""
 
     integrator: bpy.props.EnumProperty(
-        name="Integrator", items=INTEGRATORS, default="PATH",
+        name="Integrator", items=INTEGRATOR_ITEMS,
+        default=integrators.get(integrators.DEFAULT).enum_id,
         description="Light transport algorithm")
     depth: bpy.props.IntProperty(
-        name="Depth", default=5, min=1, max=16,
+        name="Depth", default=integrators.DEFAULT_DEPTH, min=integrators.DEPTH_RANGE[0],
+        max=integrators.DEPTH_RANGE[1],
         description="Ray levels of Whitted and distribution ray tracing (the camera ray is level 1)")
     branching: bpy.props.IntProperty(
-        name="Branching", default=4, min=1, max=64,
+        name="Branching", default=integrators.DEFAULT_BRANCHING,
+        min=integrators.BRANCHING_RANGE[0], max=integrators.BRANCHING_RANGE[1],
         description="Secondary rays per hit in distribution ray tracing")
 
     last_effects: bpy.props.StringProperty(

@@ -13,6 +13,7 @@ Everything is undone on unregister.
 from __future__ import annotations
 
 import bpy
+from mcengine.integrators import from_enum
 
 from .engine import ENGINE_ID
 
@@ -70,12 +71,13 @@ def _draw_integrator(layout, settings) -> None:
     col.use_property_split = True
     col.use_property_decorate = False
     col.prop(settings, "integrator")
-    if settings.integrator in ("WHITTED", "DISTRIBUTION"):
+    info = from_enum(settings.integrator)
+    if info.uses_depth:
         col.prop(settings, "depth")
-    if settings.integrator == "DISTRIBUTION":
+    if info.uses_branching:
         col.prop(settings, "branching")
-        rays = sum(settings.branching ** k for k in range(settings.depth))
-        col.label(text=f"Up to {rays:,} rays per sample (1 + b + ... + b^(depth-1))")
+        rays = info.rays_per_sample(settings.depth, settings.branching)
+        col.label(text=f"Up to {rays:,} rays per sample ({info.rays_formula()})")
 
 
 def compatible_panels() -> list:

@@ -2,15 +2,15 @@
 
 The operator renders the scene as it is in memory (saved or not) with MC
 Engine and with Cycles, ``seeds`` times each under matched settings
-(``comparison.compare_scene``, which puts every setting back afterwards),
-writes the comparison files (``mcengine.report``), loads ``side_by_side.png``
+(``batch.comparison.compare_scene``, which puts every setting back afterwards),
+writes the comparison files (``mcengine.evaluation.output``), loads ``side_by_side.png``
 as the image "MC Engine vs Cycles", shows it in an Image Editor and reports
 the verdict in the info bar: INFO when the engines agree, WARNING when they
 differ, ERROR when a render failed.
 
 "Study Accuracy vs Time" runs a short study of the scene in memory
-(``study.study_scene``: every integrator at 1, 2, 4, ... samples, small
-image), writes the study's files (``mcengine.study``), loads
+(``batch.study.study_scene``: every integrator at 1, 2, 4, ... samples, small
+image), writes the study's files (``mcengine.evaluation.output``), loads
 ``error_vs_time.png`` as the image "MC Engine Study", shows it in an Image
 Editor and reports one line: each integrator's time to the target error or
 the error where it levels off.
@@ -75,9 +75,9 @@ class MCENGINE_OT_compare_with_cycles(_RendersScene, bpy.types.Operator):
         return context.window_manager.invoke_props_dialog(self, confirm_text="Compare")
 
     def execute(self, context):
-        from mcengine.report import write_comparison
+        from mcengine.evaluation.output import write_comparison
 
-        from .comparison import CompareError, CompareOptions, compare_scene
+        from .batch.comparison import CompareError, CompareOptions, compare_scene
 
         scene = context.scene
         out = self._output_folder(scene)
@@ -142,14 +142,15 @@ class MCENGINE_OT_study_accuracy(_RendersScene, bpy.types.Operator):
         return context.window_manager.invoke_props_dialog(self, confirm_text="Study")
 
     def execute(self, context):
-        from mcengine.study import INTEGRATORS, StudyError, StudyOptions, summarise, write_study
+        from mcengine.evaluation.output import write_study
+        from mcengine.evaluation.study import StudyError, StudyOptions, summarise
 
-        from .study import StudySettings, study_scene
+        from .batch.study import StudySettings, study_scene
 
         scene = context.scene
         out = _output_folder(self.directory, STUDY_FOLDER, scene)
-        options = StudyOptions(integrators=INTEGRATORS, with_cycles=self.with_cycles,
-                               max_samples=self.max_samples, seeds=self.seeds)
+        options = StudyOptions(with_cycles=self.with_cycles, max_samples=self.max_samples,
+                               seeds=self.seeds)       # every integrator
         settings = StudySettings(resolution=_study_size(scene, self.size))
         wm = context.window_manager
         wm.progress_begin(0, 1)

@@ -39,9 +39,11 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     import bpy  # noqa: F401  (Blender as a module)
-    from mcengine_blender import batch, engine
+    from mcengine_blender import engine
+    from mcengine_blender.batch.render import ensure_registered, open_scene, render_scene
+    from mcengine_blender.batch.settings import make_unbiased
 
-    batch.ensure_registered()
+    ensure_registered()
     sessions = []
     real_factory = engine.session_factory
 
@@ -55,9 +57,9 @@ def main(argv=None) -> int:
     pixels = args.resolution * args.resolution
 
     def run(bl_engine, samples):
-        scene = batch.open_blend(SCENE)
-        batch.make_unbiased(scene)
-        return batch.render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
+        scene = open_scene(SCENE)
+        make_unbiased(scene)
+        return render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
 
     # Warm-up: load numba's kernel cache and Cycles' kernels once.
     run("mcengine", 1)

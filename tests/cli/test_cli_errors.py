@@ -18,7 +18,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mcengine_blender import cli
+from mcengine_blender.batch.render import error_message
+from mcengine_blender.cli.args import ZSTD_MAGIC, _output_for, frame_path
+from mcengine_blender.cli.console import PROGRESS_BAR_WIDTH, Progress, engine_traceback, warning_lines
+from mcengine_blender.cli.errors import EXIT_BAD_INPUT, EXIT_RENDER_FAILED
 
 REPO = Path(__file__).resolve().parents[2]
 MCENGINE = Path(sys.executable).with_name("mcengine")
@@ -100,7 +103,7 @@ def _raw_blend(path: Path) -> bytes:
     """Uncompressed bytes of a .blend (Blender 5 saves zstd-compressed files)."""
     import zstandard
     data = path.read_bytes()
-    if data.startswith(cli.ZSTD_MAGIC):
+    if data.startswith(ZSTD_MAGIC):
         return zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data)).read()
     return data
 
@@ -138,19 +141,19 @@ def _raw_blend(path: Path) -> bytes:
 def test_bad_input_is_one_line_and_exit_2(args, fragments, scenes, bad_files):
     args = [arg.format(tiny=scenes / "tiny.blend", bad=bad_files) for arg in args]
     done = run_cli(*args)
-    assert_one_line_error(done, cli.EXIT_BAD_INPUT, *fragments)
+    assert_one_line_error(done, EXIT_BAD_INPUT, *fragments)
 
 
 def test_corrupt_blend_reports_blenders_reason(bad_files, tmp_path):
     done = run_cli("render", bad_files / "truncated.blend", "--engine", "cycles", "-o", tmp_path / "x.exr")
-    assert_one_line_error(done, cli.EXIT_RENDER_FAILED, "cannot open", "truncated.blend")
+    assert_one_line_error(done, EXIT_RENDER_FAILED, "cannot open", "truncated.blend")
     assert not (tmp_path / "x.exr").exists()
 
 
 def test_failed_render_reports_engine_error(scenes, tmp_path):
     done = run_cli("render", scenes / "nocamera.blend", "--engine", "cycles", "--resolution", "16x16",
                    "--samples", "1", "-o", tmp_path / "x.exr")
-    assert_one_line_error(done, cli.EXIT_RENDER_FAILED, "render failed", "camera")
+    assert_one_line_error(done, EXIT_RENDER_FAILED, "render failed", "camera")
     assert not (tmp_path / "x.exr").exists()
 
 
@@ -160,10 +163,18 @@ def test_bad_input_fails_before_importing_blender(scenes):
             f"code = cli.main(['render', {str(scenes / 'tiny.blend')!r}, '--samples', '0']); "
             "print('bpy imported' if 'bpy' in sys.modules else 'bpy not imported'); sys.exit(code)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert done.returncode == cli.EXIT_BAD_INPUT, done.stderr
+    assert done.returncode == EXIT_BAD_INPUT, done.stderr
     assert done.stdout.strip() == "bpy not imported", (
         "importing mcengine_blender.cli imported bpy: addon/__init__.py (run for every CLI call) "
         "must import its bpy modules inside register()/unregister()")
+
+
+def test_runs_as_a_module(bad_files):
+    """``python -m mcengine_blender.cli`` is the ``mcengine`` command."""
+    done = subprocess.run([sys.executable, "-m", "mcengine_blender.cli", "render",
+                           str(bad_files / "missing.blend")], capture_output=True, text=True,
+                          timeout=60, stdin=subprocess.DEVNULL)
+    assert_one_line_error(done, EXIT_BAD_INPUT, "file not found")
 
 
 # ---------------------------------------------------------------------------
@@ -193,7 +204,7 @@ def test_blender_syntax_with_frame_padding_and_relative_path(scenes):
     args = ["-b", blend, "-E", "cycles", "-o", "//frames/out_####", "-F", "PNG", "-f", "12",
             "--resolution", "20x12", "--samples", "1"]
     # "//" is the .blend's folder, so the missing "frames" folder is found there first.
-    assert_one_line_error(run_cli(*args), cli.EXIT_BAD_INPUT, f"does not exist: {scenes / 'frames'}")
+    assert_one_line_error(run_cli(*args), EXIT_BAD_INPUT, f"does not exist: {scenes / 'frames'}")
     (scenes / "frames").mkdir()
     done = run_cli(*args)
     expected = scenes / "frames" / "out_0012.png"
@@ -242,15 +253,15 @@ def test_mcengine_render_writes_float_exr(scenes, tmp_path):
 def test_output_paths_follow_blender(raw, fmt, frame, expected, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     blend_dir = tmp_path / "scenes"
-    output = cli._output_for(raw, fmt, blend_dir)
-    path = cli.frame_path(output.pattern, frame)
+    output = _output_for(raw, fmt, blend_dir)
+    path = frame_path(output.pattern, frame)
     assert str(path) == expected.format(blend_dir=blend_dir, cwd=tmp_path)
     assert output.file_format == (fmt or ("PNG" if raw.endswith(".png") else "OPEN_EXR"))
 
 
 def test_progress_prints_a_line_per_tenth_when_not_a_terminal():
     stream = io.StringIO()
-    progress = cli.Progress(stream, "MCENGINE")
+    progress = Progress(stream, "MCENGINE")
     progress.update("Mem: 2M | Synchronizing object | Cube")
     for sample in range(1, 21):
         progress.on_stats(f"Remaining: 00:01.00 | Mem: 2M | Sample {sample}/20")
@@ -266,7 +277,7 @@ def test_progress_redraws_one_line_on_a_terminal():
             return True
 
     stream = Terminal()
-    progress = cli.Progress(stream, "CYCLES")
+    progress = Progress(stream, "CYCLES")
     for sample in (1, 2, 4):
         progress.on_stats(f"Sample {sample}/4")
     progress.on_stats(None)  # handlers must never raise
@@ -274,7 +285,7 @@ def test_progress_redraws_one_line_on_a_terminal():
     text = stream.getvalue()
     assert "\n" not in text
     assert text.count("\r") == 4
-    assert "[" + "#" * cli.PROGRESS_BAR_WIDTH + "] 100%" in text
+    assert "[" + "#" * PROGRESS_BAR_WIDTH + "] 100%" in text
 
 
 def test_engine_crash_is_found_in_blenders_log():
@@ -284,11 +295,11 @@ def test_engine_crash_is_found_in_blenders_log():
            "    raise ValueError('no lights')\n"
            "ValueError: no lights\n"
            "Warning: textures are ignored, using base colour\n")
-    assert cli.engine_traceback(log) == "ValueError: no lights"
-    assert cli.engine_traceback("Warning: x\n") is None
-    assert cli.warning_lines(log) == ["textures are ignored, using base colour"]
+    assert engine_traceback(log) == "ValueError: no lights"
+    assert engine_traceback("Warning: x\n") is None
+    assert warning_lines(log) == ["textures are ignored, using base colour"]
 
 
 def test_operator_errors_become_one_line():
     error = RuntimeError("Error: No camera found in scene\nError: No camera found in scene\n")
-    assert cli.error_message(error) == "No camera found in scene"
+    assert error_message(error) == "No camera found in scene"

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from mcengine_blender import cli
+from mcengine_blender.cli.errors import EXIT_BAD_INPUT, EXIT_DIFFER, EXIT_OK, EXIT_RENDER_FAILED
 
 REPO = Path(__file__).resolve().parents[2]
 MCENGINE = Path(sys.executable).with_name("mcengine")
@@ -114,7 +114,7 @@ def test_bad_input_is_one_line_and_exit_2(args, fragments, scenes, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     args = [a.format(plain=scenes / "plain.blend", folder=scenes, empty=empty) for a in args]
-    assert_one_line_error(run_cli(*args, cwd=tmp_path), cli.EXIT_BAD_INPUT, *fragments)
+    assert_one_line_error(run_cli(*args, cwd=tmp_path), EXIT_BAD_INPUT, *fragments)
 
 
 def test_bad_input_fails_before_importing_blender(scenes):
@@ -122,7 +122,7 @@ def test_bad_input_fails_before_importing_blender(scenes):
             f"code = cli.main(['compare', {str(scenes / 'plain.blend')!r}, '--seeds', '1']); "
             "print('bpy imported' if 'bpy' in sys.modules else 'bpy not imported'); sys.exit(code)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert done.returncode == cli.EXIT_BAD_INPUT, done.stderr
+    assert done.returncode == EXIT_BAD_INPUT, done.stderr
     assert done.stdout.strip() == "bpy not imported"
 
 
@@ -134,7 +134,7 @@ def test_compare_writes_every_file_and_exits_0_on_agree(tmp_path):
     out = tmp_path / "new" / "out"  # created, with its parent
     done = run_cli("compare", CORNELL_BOX, "--samples", "16", "--resolution", "32x32",
                    "--out", out)
-    assert done.returncode == cli.EXIT_OK, done.stderr
+    assert done.returncode == EXIT_OK, done.stderr
     assert done.stdout == f"{out / 'report.json'}\n"
     assert "Traceback" not in done.stderr
     report = json.loads((out / "report.json").read_text())
@@ -162,7 +162,7 @@ def test_compare_writes_every_file_and_exits_0_on_agree(tmp_path):
 def test_compare_exits_3_on_differ_and_says_why(scenes, tmp_path):
     done = run_cli("compare", scenes / "textured.blend", "--samples", "8", "--resolution", "16x16",
                    "--out", tmp_path)
-    assert done.returncode == cli.EXIT_DIFFER, done.stderr
+    assert done.returncode == EXIT_DIFFER, done.stderr
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["verdict"] == "differ"
     assert report["regions"], "the checker squares should show as regions"
@@ -173,7 +173,7 @@ def test_compare_exits_3_on_differ_and_says_why(scenes, tmp_path):
 def test_failed_render_is_one_line_and_exit_1(scenes, tmp_path):
     done = run_cli("compare", scenes / "nocamera.blend", "--samples", "4", "--resolution", "16x16",
                    "--out", tmp_path)
-    assert_one_line_error(done, cli.EXIT_RENDER_FAILED, "render failed", "camera")
+    assert_one_line_error(done, EXIT_RENDER_FAILED, "render failed", "camera")
 
 
 def test_suite_writes_one_summary_and_keeps_going_after_a_failure(scenes, tmp_path):
@@ -184,7 +184,7 @@ def test_suite_writes_one_summary_and_keeps_going_after_a_failure(scenes, tmp_pa
     out = tmp_path / "out"
     done = run_cli("compare", "--suite", folder, "--samples", "8", "--resolution", "50%",
                    "--out", out)
-    assert done.returncode == cli.EXIT_RENDER_FAILED, done.stderr  # a failure outranks a differ
+    assert done.returncode == EXIT_RENDER_FAILED, done.stderr  # a failure outranks a differ
     assert done.stdout == f"{out / 'summary.json'}\n"
     summary = json.loads((out / "summary.json").read_text())
     verdicts = {row["scene"]: row["verdict"] for row in summary["scenes"]}

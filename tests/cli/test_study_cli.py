@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from mcengine_blender import cli
+from mcengine_blender.cli.errors import EXIT_BAD_INPUT, EXIT_RENDER_FAILED
 
 MCENGINE = Path(sys.executable).with_name("mcengine")
 TIMEOUT = 300  # seconds; the tiny study takes about 15, JIT compilation more
@@ -73,7 +74,7 @@ def run_cli(*args) -> subprocess.CompletedProcess:
 ])
 def test_bad_options_are_one_line_before_blender_starts(args, fragment, scenes, capsys):
     args = [a.format(cube=scenes / "cube.blend", missing=scenes / "missing.blend") for a in args]
-    assert cli.main(args) == cli.EXIT_BAD_INPUT
+    assert cli.main(args) == EXIT_BAD_INPUT
     out, err = capsys.readouterr()
     assert out == ""
     assert len(err.splitlines()) == 1 and err.startswith("mcengine: error: "), err
@@ -85,7 +86,7 @@ def test_bad_study_options_fail_before_importing_blender(scenes):
             f"code = cli.main(['study', {str(scenes / 'cube.blend')!r}, '--seeds', '1']); "
             "print('bpy imported' if 'bpy' in sys.modules else 'bpy not imported'); sys.exit(code)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert done.returncode == cli.EXIT_BAD_INPUT, done.stderr
+    assert done.returncode == EXIT_BAD_INPUT, done.stderr
     assert done.stdout.strip() == "bpy not imported"
 
 
@@ -116,7 +117,7 @@ def test_study_writes_one_row_per_render_and_the_report(scenes, tmp_path):
 def test_study_of_a_scene_without_camera_fails_in_one_line(scenes, tmp_path):
     done = run_cli("study", scenes / "nocamera.blend", "--max-samples", "1", "--seeds", "2",
                    "--resolution", "8x8", "--integrators", "path", "--out", tmp_path)
-    assert done.returncode == cli.EXIT_RENDER_FAILED, done.stderr
+    assert done.returncode == EXIT_RENDER_FAILED, done.stderr
     lines = done.stderr.splitlines()
     assert lines[-1].startswith("mcengine: error: path render failed") and "camera" in lines[-1]
     assert "Traceback" not in done.stderr and done.stdout == ""

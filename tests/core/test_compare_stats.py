@@ -1,4 +1,4 @@
-"""Tests of mcengine.compare: the test that decides whether two renders agree.
+"""Tests of mcengine.evaluation.stats: the test that decides whether two renders agree.
 
 Synthetic "renders" are a smooth ground-truth image times per-pixel
 multiplicative lognormal noise of mean 1 (skewed and heavy-tailed, like Monte
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from mcengine.compare import (
+from mcengine.evaluation.stats import (
     MAX_CORRELATION_LAG, _lag_correlation, block_edges, block_means, compare_stacks,
     holm_adjust, relmse, smape, student_t_isf, student_t_sf,
 )

@@ -1,4 +1,4 @@
-"""mcengine.report: the comparison report, its figure and the suite table (no bpy).
+"""mcengine.evaluation: the comparison report, its figure and the suite table (no bpy).
 
 Synthetic stacks with known noise and known differences stand in for renders.
 """
@@ -9,10 +9,11 @@ import struct
 import numpy as np
 import pytest
 
-from mcengine.compare import compare_stacks
-from mcengine.report import (EngineRuns, SuiteRow, build_comparison, detectable_bias,
-                             differing_regions, suite_html, suite_markdown, suite_row,
-                             write_comparison, write_suite)
+from mcengine.evaluation.comparison import (EngineRuns, SuiteRow, build_comparison,
+                                            detectable_bias, differing_regions, suite_row)
+from mcengine.evaluation.output import write_comparison, write_suite
+from mcengine.evaluation.pages import suite_html, suite_markdown
+from mcengine.evaluation.stats import compare_stacks
 
 H, W = 48, 64
 NOISE = 0.05  # relative per-pixel noise of one render

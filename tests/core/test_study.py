@@ -13,8 +13,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from mcengine import study as S
-from mcengine.compare import relmse
+from mcengine.evaluation import study as S
+from mcengine.evaluation.datafiles import COLUMNS, read_csv
+from mcengine.evaluation.output import write_study
+from mcengine.evaluation.stats import relmse
 from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
 
@@ -155,9 +157,9 @@ def test_study_writes_one_csv_row_per_render_and_every_file(tmp_path):
                              seeds=2, reference_renders=2)
     labels = []
     study = S.run_study(fake, options, scene="fake", on_render=lambda label, i, n: labels.append((i, n)))
-    paths = S.write_study(study, tmp_path)
-    rows = S.read_csv(paths["csv"])
-    assert open(paths["csv"]).readline().strip().split(",") == list(S.COLUMNS)
+    paths = write_study(study, tmp_path)
+    rows = read_csv(paths["csv"])
+    assert open(paths["csv"]).readline().strip().split(",") == list(COLUMNS)
     assert len(rows) == 3 * 4 * 2       # (path, raycast, cycles) x (1, 2, 4, 8) x 2 seeds
     assert {(r.integrator, r.samples) for r in rows} == {
         (m, n) for m in ("path", "raycast", "cycles") for n in (1, 2, 4, 8)}

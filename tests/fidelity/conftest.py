@@ -19,8 +19,9 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from mcengine.report import build_comparison  # noqa: E402
-from mcengine_blender.comparison import CompareOptions, open_scene, render_runs  # noqa: E402
+from mcengine.evaluation.comparison import build_comparison  # noqa: E402
+from mcengine_blender.batch.comparison import CompareOptions, render_runs  # noqa: E402
+from mcengine_blender.batch.render import open_scene  # noqa: E402
 
 SCENES_DIR = Path(__file__).resolve().parents[2] / "blend_scenes"
 SCENES = sorted(SCENES_DIR.glob("*.blend"))

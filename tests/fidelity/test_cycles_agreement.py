@@ -3,7 +3,7 @@
 Test: each engine renders the scene at the CI setting (conftest: half the
 stored resolution, 128 samples, two seeds; more samples for the scenes in
 ``STRONGER``) through ``bpy.ops.render.render``, as F12 does, under matched
-unbiased settings (``mcengine_blender.comparison``).  ``mcengine.compare``
+unbiased settings (``mcengine_blender.batch.comparison``).  ``mcengine.evaluation.stats``
 estimates each engine's noise per pixel from the seed-to-seed spread and
 compares the frame means and the means of an 8x8 grid of blocks, per RGB
 channel, with Welch t-tests; Holm-Bonferroni keeps the family-wise false
@@ -21,7 +21,8 @@ import json
 import numpy as np
 import pytest
 
-from mcengine.report import detectable_bias, suite_row, write_comparison, write_suite
+from mcengine.evaluation.comparison import detectable_bias, suite_row
+from mcengine.evaluation.output import write_comparison, write_suite
 
 from .conftest import SCENES
 

@@ -10,7 +10,7 @@ import bpy
 import numpy as np
 import pytest
 
-from mcengine.report import build_comparison
+from mcengine.evaluation.comparison import build_comparison
 
 from .conftest import SCENES, options_for
 

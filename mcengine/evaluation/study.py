@@ -66,61 +66,42 @@ grows with N, falling for a biased one once it plateaus.
 
 Conventions
 -----------
-* relMSE is :func:`mcengine.compare.relmse` (top 0.1 % of pixels trimmed,
-  ``eps = 1e-2``; ``relmse_untrimmed`` without trimming) and SMAPE
-  :func:`mcengine.compare.smape`, on RGB.
+* relMSE is :func:`mcengine.evaluation.stats.relmse` (top 0.1 % of pixels
+  trimmed, ``eps = 1e-2``; ``relmse_untrimmed`` without trimming) and SMAPE
+  :func:`mcengine.evaluation.stats.smape`, on RGB.
 * ``seconds`` is whatever the render callable reports; the Blender driver
-  (``mcengine_blender.study``) times the render call alone.
-* Integrator names are ``path``, ``raycast``, ``whitted``, ``distribution``
-  and ``cycles``.  Images are ``(h, w, 3|4)`` float, top row first.
+  (``mcengine_blender.batch.study``) times the render call alone.
+* Engines are MC Engine's integrators, by their names in
+  :mod:`mcengine.integrators`, and ``cycles``.  Images are ``(h, w, 3|4)``
+  float, top row first.
 * A render callable is ``render(integrator, samples, seed)`` returning an
   object with ``.image`` and ``.seconds``.
 
-No bpy; matplotlib is imported only to draw the plots.
+This module is the model: it runs the study and fits it, and never draws or
+writes; :func:`mcengine.evaluation.output.write_study` writes the CSV, plots,
+pages and JSON.  No bpy, no matplotlib.
 """
 from __future__ import annotations
 
-import csv
-import html
-import json
 import math
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from .compare import relmse, smape, student_t_isf
-from .imageio import to_display
+from ..integrators import INTEGRATORS, NAMES, get as get_integrator
+from ..imageio import to_display
+from .comparison import CYCLES_LABEL
+from .stats import jsonable, relmse, smape, student_t_isf
 
 __all__ = [
-    "INTEGRATORS", "CYCLES", "COLUMNS", "StudyOptions", "StudyError", "Reference", "StudyRow",
-    "Preview", "Study", "Rung", "Summary", "ladder", "run_study", "reference_self_relmse",
-    "fit_error_model", "significant_bias", "fit_slope", "time_to_target",
-    "summarise_integrator", "summarise", "write_csv", "read_csv",
-    "plot_error", "equal_time_strip", "target_table_markdown", "study_html", "write_study",
+    "CYCLES", "StudyOptions", "StudyError", "Reference", "StudyRow", "Preview", "Study", "Rung",
+    "Summary", "engine_label", "ladder", "run_study", "reference_self_relmse", "fit_error_model",
+    "significant_bias", "fit_slope", "time_to_target", "summarise_integrator", "summarise",
 ]
 
-INTEGRATORS = ("path", "raycast", "whitted", "distribution")
 CYCLES = "cycles"
 REFERENCE_INTEGRATOR = "path"
-LABELS = {"path": "Path tracing", "raycast": "Ray casting", "whitted": "Whitted",
-          "distribution": "Distribution", "cycles": "Cycles"}
-# What each biased algorithm leaves out, for the plain-words explanation of a plateau.
-MISSING_LIGHT = {
-    "raycast": "it stops at the first hit, so all light reflected between surfaces (indirect "
-               "light) and everything seen in mirrors or through glass is missing",
-    "whitted": "it follows only perfect mirror and refraction rays, so light reflected between "
-               "diffuse or glossy surfaces is missing",
-    "distribution": "its ray tree stops at the depth, so light that needs more bounces is missing",
-    "path": "path tracing is unbiased: a plateau means the reference is not converged enough "
-            "or the two differ",
-    "cycles": "Cycles is unbiased with these settings: a plateau means its reference is not "
-              "converged enough",
-}
-
-COLUMNS = ("integrator", "samples", "seed", "replicate", "seconds", "relmse", "relmse_untrimmed",
-           "smape", "reference")
 
 DEFAULT_MAX_SAMPLES = 64
 DEFAULT_SEEDS = 3
@@ -162,13 +143,20 @@ PREVIEW_MAX_SIDE = 256
 # than the common time (ladders double, so the nearest rung is within 2x).
 EQUAL_TIME_SLACK = 1.25
 
-COLORS = {"path": "C0", "raycast": "C1", "whitted": "C2", "distribution": "C3", "cycles": "C7"}
-MARKERS = {"path": "o", "raycast": "s", "whitted": "^", "distribution": "D", "cycles": "v"}
-FIGURE_DPI = 110
-
 
 class StudyError(ValueError):
     """Invalid study options; the message says which and why."""
+
+
+def engine_label(engine: str) -> str:
+    """How reports name an engine: its integrator's label in sentence case
+    ("Path tracing", "Ray casting"), "Cycles", or the name itself if unknown."""
+    if engine == CYCLES:
+        return CYCLES_LABEL
+    info = INTEGRATORS.get(engine)
+    if info is None:
+        return engine
+    return info.label[:1] + info.label[1:].lower()
 
 
 # ----------------------------------------------------------------------------
@@ -196,7 +184,7 @@ class StudyOptions:
     belong to the driver that renders.
     """
 
-    integrators: tuple = INTEGRATORS
+    integrators: tuple = NAMES
     with_cycles: bool = False
     max_samples: int = DEFAULT_MAX_SAMPLES
     seeds: int = DEFAULT_SEEDS
@@ -205,9 +193,11 @@ class StudyOptions:
     target_relmse: float = DEFAULT_TARGET_RELMSE
 
     def validate(self) -> "StudyOptions":
-        unknown = [m for m in self.integrators if m not in INTEGRATORS]
-        if unknown:
-            raise StudyError(f"unknown integrator {unknown[0]!r} (choose from {', '.join(INTEGRATORS)})")
+        for name in self.integrators:
+            try:
+                get_integrator(name)
+            except ValueError as exc:
+                raise StudyError(str(exc)) from None
         if not self.integrators and not self.with_cycles:
             raise StudyError("nothing to study: no integrator and no Cycles")
         if self.seeds < 2:
@@ -311,7 +301,7 @@ def reference_self_relmse(images, trim: float = 0.001, eps: float = 1e-2) -> flo
 
     Per pixel, the variance of the K-render mean is the renders' sample
     variance (ddof 1) over K; it is divided by ``mean**2 + eps`` like
-    :func:`mcengine.compare.relmse`, averaged over RGB, and the largest
+    :func:`mcengine.evaluation.stats.relmse`, averaged over RGB, and the largest
     ``trim`` share of pixels is dropped before averaging.
 
     Parameters
@@ -517,7 +507,7 @@ class Summary:
         out["rungs"] = [dict(asdict(r), efficiency=r.efficiency) for r in self.rungs]
         out.update(bias=self.bias, efficiency=self.efficiency,
                    slope_consistent_with_minus_one=self.slope_consistent())
-        return _jsonable(out)
+        return jsonable(out)
 
 
 def fit_error_model(samples, relmse_mean, relative_se: float | None = None):
@@ -716,441 +706,3 @@ def summarise(study: Study) -> dict:
         r, r_full = (ref.self_relmse, ref.self_relmse_untrimmed) if ref is not None else (0.0, 0.0)
         out[name] = summarise_integrator(rows, r, study.options.target_relmse, r_full)
     return out
-
-
-# ----------------------------------------------------------------------------
-# CSV
-# ----------------------------------------------------------------------------
-
-def write_csv(rows, path) -> None:
-    """One line per render, columns :data:`COLUMNS`."""
-    with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
-        writer.writeheader()
-        for row in rows:
-            d = asdict(row)
-            d["seconds"] = f"{row.seconds:.6g}"
-            d["relmse"] = f"{row.relmse:.8g}"
-            d["relmse_untrimmed"] = f"{row.relmse_untrimmed:.8g}"
-            d["smape"] = f"{row.smape:.8g}"
-            writer.writerow(d)
-
-
-def read_csv(path) -> list[StudyRow]:
-    """Rows written by :func:`write_csv`."""
-    with open(path, newline="") as f:
-        return [StudyRow(integrator=d["integrator"], samples=int(d["samples"]), seed=int(d["seed"]),
-                         replicate=int(d["replicate"]), seconds=float(d["seconds"]),
-                         relmse=float(d["relmse"]),
-                         relmse_untrimmed=float(d["relmse_untrimmed"]), smape=float(d["smape"]),
-                         reference=d["reference"])
-                for d in csv.DictReader(f)]
-
-
-# ----------------------------------------------------------------------------
-# Plots and images
-# ----------------------------------------------------------------------------
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
-def _guide(ax, xs, y0, slope, label):
-    """A dashed power-law guide ``y0 * (x / x0)**slope`` over ``xs``' range."""
-    x = np.array([min(xs), max(xs)], float)
-    ax.plot(x, y0 * (x / x[0]) ** slope, color="0.45", linestyle="--", linewidth=1.0,
-            label=label, zorder=1)
-
-
-def _label_floors(ax, summaries: dict) -> None:
-    """Name each plateau line at the right edge; equal floors (within 2 %) share a label."""
-    groups = []
-    for name, s in summaries.items():
-        if not s.plateau:
-            continue
-        for group in groups:
-            if abs(group[0] / s.floor - 1.0) < 0.02:
-                group[1].append(name)
-                break
-        else:
-            groups.append((s.floor, [name]))
-    for floor, names in groups:
-        text = " and ".join(LABELS.get(n, n) for n in names) + f": bias floor {floor:.2g}"
-        ax.annotate(text, xy=(0.98, floor), xycoords=("axes fraction", "data"), ha="right",
-                    va="top", fontsize=7.5, color=COLORS.get(names[0]), zorder=4,
-                    xytext=(0, -3), textcoords="offset points",
-                    bbox=dict(boxstyle="square,pad=0.1", facecolor="white", edgecolor="none",
-                              alpha=0.8))
-
-
-def plot_error(summaries: dict, path, x: str = "seconds", title: str = "") -> None:
-    """relMSE and SMAPE against time or samples, log-log, one curve per integrator.
-
-    Markers are the mean over seeds, bars the smallest and largest seed.
-    The relMSE panel has a 1/x guide (slope -1), the target as a dotted line
-    and each plateauing integrator's fitted floor as a thin line of its
-    colour; the SMAPE panel a 1/sqrt(x) guide.
-    """
-    if x not in ("seconds", "samples"):
-        raise StudyError(f"x must be 'seconds' or 'samples', got {x!r}")
-    plt = _pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(11.5, 4.6), dpi=FIGURE_DPI)
-    xlabel = "render time (s)" if x == "seconds" else "samples per pixel"
-    xs_all = [getattr(r, x) for s in summaries.values() for r in s.rungs]
-    for ax, metric in zip(axes, ("relmse", "smape")):
-        for name, s in summaries.items():
-            xs = [getattr(r, x) for r in s.rungs]
-            ys = np.array([getattr(r, metric) for r in s.rungs])
-            lo = np.array([getattr(r, metric + "_lo") for r in s.rungs])
-            hi = np.array([getattr(r, metric + "_hi") for r in s.rungs])
-            ax.errorbar(xs, ys, yerr=[ys - lo, hi - ys], color=COLORS.get(name),
-                        marker=MARKERS.get(name, "o"), markersize=5, capsize=2, linewidth=1.4,
-                        label=LABELS.get(name, name), zorder=3)
-            if metric == "relmse" and s.plateau:
-                ax.axhline(s.floor, color=COLORS.get(name), linewidth=0.8, alpha=0.6, zorder=2)
-        if metric == "relmse":
-            _label_floors(ax, summaries)
-        first = next(iter(summaries.values()))
-        anchor = first.rungs[0]
-        if metric == "relmse":
-            _guide(ax, xs_all, anchor.relmse * (min(xs_all) / getattr(anchor, x)) ** -1, -1.0,
-                   "∝ 1/N" if x == "samples" else "∝ 1/time")
-            target = first.target
-            ax.axhline(target, color="k", linestyle=":", linewidth=1.0,
-                       label=f"target relMSE {target:g}")
-            ax.set_ylabel("relMSE (top 0.1 % trimmed)")
-        else:
-            _guide(ax, xs_all, anchor.smape * (min(xs_all) / getattr(anchor, x)) ** -0.5, -0.5,
-                   "∝ 1/√N" if x == "samples" else "∝ 1/√time")
-            ax.set_ylabel("SMAPE")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(xlabel)
-        ax.grid(True, which="both", alpha=0.25)
-    axes[0].legend(fontsize=8, loc="best")
-    fig.suptitle(title or ("Error against " + ("time" if x == "seconds" else "samples")))
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
-
-def _equal_time_choice(study: Study, summaries: dict):
-    """The common time T and, per integrator, the preview taken closest to it.
-
-    T is the longest time every integrator spent on some render; each
-    integrator shows its longest render within ``EQUAL_TIME_SLACK * T``
-    (its fastest one if even that took longer).
-    """
-    names = [n for n in summaries if study.previews.get(n)]
-    if not names:
-        return None, {}
-    common = min(max(p.seconds for p in study.previews[n]) for n in names)
-    chosen = {}
-    for n in names:
-        within = [p for p in study.previews[n] if p.seconds <= EQUAL_TIME_SLACK * common]
-        chosen[n] = max(within, key=lambda p: p.seconds) if within else min(
-            study.previews[n], key=lambda p: p.seconds)
-    return common, chosen
-
-
-def equal_time_strip(study: Study, summaries: dict, path) -> dict:
-    """Save the strip of images at (about) equal time; returns integrator -> Preview shown.
-
-    Each panel is labelled with its integrator, samples, time and relMSE;
-    the references come last.
-    """
-    common, chosen = _equal_time_choice(study, summaries)
-    panels = []
-    for name, p in chosen.items():
-        err = next((r.relmse for r in study.rows if r.integrator == name
-                    and r.samples == p.samples and r.replicate == 0), float("nan"))
-        panels.append((p.image, f"{LABELS.get(name, name)}\n{p.samples} spp, {p.seconds:.2f} s, "
-                                f"relMSE {err:.3g}"))
-    for engine, img in study.reference_previews.items():
-        ref = study.references[engine]
-        panels.append((img, f"{LABELS.get(engine, engine)} reference\n{ref.samples} spp, "
-                            f"{ref.seconds:.0f} s"))
-    if not panels:
-        return {}
-    plt = _pyplot()
-    h, w = panels[0][0].shape[:2]
-    scale = 2.4 / max(h, w)
-    fig, axes = plt.subplots(1, len(panels), figsize=(len(panels) * w * scale, h * scale + 0.75),
-                             dpi=FIGURE_DPI, squeeze=False)
-    for ax, (img, label) in zip(axes[0], panels):
-        ax.imshow(img, interpolation="nearest")
-        ax.set_title(label, fontsize=8)
-        ax.axis("off")
-    fig.suptitle(f"Equal time: about {common:.2f} s each (render time)" if common else "",
-                 fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return chosen
-
-
-# ----------------------------------------------------------------------------
-# Text: Markdown table and HTML report
-# ----------------------------------------------------------------------------
-
-def _fmt_time(s: Summary) -> str:
-    if s.time_to_target is None:
-        return f"not reached (error levels off at {s.floor:.3g})" if s.plateau or s.floor >= s.target \
-            else "not reached"
-    text = f"{s.time_to_target:.2f} s"
-    if s.target_how == "first rung":
-        return f"≤ {text} (at 1 spp)"
-    if s.target_how == "extrapolated":
-        return f"~{text} (extrapolated)"
-    return text
-
-
-def _fmt_slope(s: Summary) -> str:
-    if s.slope is None:
-        return "n/a (bias dominates)" if s.plateau else f"n/a (needs {MIN_FIT_RUNGS} rungs ≥ {SLOPE_MIN_SAMPLES} spp)"
-    return f"{s.slope:.3f} ± {s.slope_ci:.3f}"
-
-
-def target_table_markdown(summaries: dict, study: Study | None = None) -> str:
-    """Markdown table: time to target relMSE, slope, plateau, efficiency per integrator."""
-    target = next(iter(summaries.values())).target if summaries else DEFAULT_TARGET_RELMSE
-    lines = [f"| integrator | time to relMSE {target:g} | relMSE slope (95 %) | bias floor | "
-             f"relMSE at max spp | efficiency 1/(relMSE·s) |",
-             "|---|---|---|---|---|---|"]
-    for name, s in summaries.items():
-        last = s.rungs[-1]
-        label = LABELS.get(name, name)
-        if study is not None and study.settings.get(name):
-            label += f" ({study.settings[name]})"
-        floor = f"{s.floor:.3g} (plateau)" if s.plateau else "none"
-        lines.append(f"| {label} | {_fmt_time(s)} | {_fmt_slope(s)} | {floor} | "
-                     f"{last.relmse:.3g} at {last.samples} | {last.efficiency:.3g} |")
-    return "\n".join(lines) + "\n"
-
-
-def _same_errors(study: Study | None, a: str, b: str) -> bool:
-    """True when integrators ``a`` and ``b`` measured exactly the same errors (same images)."""
-    if study is None:
-        return False
-    errors = {m: [r.relmse for r in study.rows if r.integrator == m] for m in (a, b)}
-    return bool(errors[a]) and errors[a] == errors[b]
-
-
-def _plateau_sentences(summaries: dict, study: Study | None = None) -> list[str]:
-    out = []
-    labels = dict(LABELS)
-    if _same_errors(study, "raycast", "whitted"):
-        out.append("Whitted ray tracing rendered exactly the images of ray casting: the scene "
-                   "has no mirror or glass, so no ray ever branches.")
-        labels["raycast"] = "Ray casting and Whitted"
-    for name, s in summaries.items():
-        label = labels.get(name, name)
-        if name == "whitted" and labels["raycast"] != LABELS["raycast"]:
-            continue          # said with ray casting
-        if s.plateau:
-            start = next((r.samples for r in s.rungs if s.noise_at(r.samples) < s.bias), 1)
-            out.append(
-                f"<b>{label}</b>: the error stops falling at relMSE ≈ {s.floor:.3g} "
-                f"(pixels off by about {100 * math.sqrt(s.bias):.0f} % on average). From about "
-                f"{start} sample{'s' if start > 1 else ''} per pixel on, more samples only make a "
-                f"wrong image less noisy: {MISSING_LIGHT.get(name, 'it is biased')}. This is what "
-                f"the cheaper algorithm costs in accuracy, and no amount of time buys it back.")
-        elif name in ("raycast", "whitted", "distribution"):
-            out.append(f"<b>{label}</b>: no plateau within this ladder (its bias, relMSE "
-                       f"≈ {s.bias:.2g}, is still below its noise at {s.rungs[-1].samples} "
-                       f"samples).")
-    return out
-
-
-def _slope_sentences(summaries: dict) -> list[str]:
-    out = []
-    for name in ("path", "cycles"):
-        s = summaries.get(name)
-        if s is None or s.slope is None:
-            continue
-        verdict = "consistent with" if s.slope_consistent() else "<b>not</b> consistent with"
-        why = ""
-        if name == "cycles" and not s.slope_consistent() and s.slope < -1:
-            why = (" It falls faster than 1/N because its samples are not independent: "
-                   "Cycles' sampler stratifies each pixel's samples (quasi-Monte Carlo).")
-        out.append(f"{LABELS[name]}: measured slope {s.slope:.3f} ± {s.slope_ci:.3f} (95 % "
-                   f"interval, standard error {s.slope_se:.3f}, {s.slope_dof} degrees of freedom "
-                   f"over {len(s.fit_samples)} sample counts), {verdict} the −1 of Monte Carlo "
-                   f"convergence with independent samples.{why}")
-    return out
-
-
-_CSS = """
-body { font-family: system-ui, sans-serif; max-width: 1180px; margin: 2em auto; padding: 0 1em;
-       color: #222; line-height: 1.45; }
-table { border-collapse: collapse; margin: 1em 0; font-size: 0.95em; }
-th, td { border: 1px solid #ccc; padding: 0.3em 0.6em; text-align: left; }
-th { background: #f3f3f3; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; }
-img { max-width: 100%; border: 1px solid #ddd; }
-.note { color: #555; font-size: 0.92em; }
-"""
-
-
-def study_html(study: Study, summaries: dict, files: dict) -> str:
-    """The report page; ``files`` maps "csv", "time", "samples", "strip" to file names."""
-    e = html.escape
-    o = study.options
-    target = o.target_relmse
-    rows = []
-    for name, s in summaries.items():
-        last = s.rungs[-1]
-        settings = study.settings.get(name, "")
-        rows.append(
-            "<tr>" + "".join([
-                f"<td>{e(LABELS.get(name, name))}" + (f"<br><span class=note>{e(settings)}</span>"
-                                                       if settings else "") + "</td>",
-                f"<td class=num>{e(_fmt_time(s))}</td>",
-                f"<td class=num>{e(_fmt_slope(s))}</td>",
-                f"<td class=num>{'%.3g' % s.floor if s.plateau else 'none'}</td>",
-                f"<td class=num>{last.relmse:.3g} / {last.smape:.3g} at {last.samples} spp</td>",
-                f"<td class=num>{last.seconds:.2f} s</td>",
-                f"<td class=num>{last.efficiency:.3g}</td>",
-            ]) + "</tr>")
-    refs = []
-    smallest = {}
-    for row in study.rows:
-        smallest[row.reference] = min(smallest.get(row.reference, math.inf), row.relmse)
-    for engine, ref in study.references.items():
-        ratio = smallest.get(engine, math.nan) / ref.self_relmse if ref.self_relmse > 0 else math.inf
-        refs.append(f"<li>{e(LABELS.get(engine, engine))}: {ref.samples} samples per pixel "
-                    f"({ref.renders} renders of {ref.samples // ref.renders}, {ref.seconds:.0f} s). "
-                    f"Its own relMSE, estimated from the spread of those renders, is "
-                    f"{ref.self_relmse:.2g}, {ratio:.0f}× below the smallest error measured "
-                    f"against it ({smallest.get(engine, math.nan):.3g}), so it is converged "
-                    f"enough to measure against; it is subtracted before fitting slopes.</li>")
-    plateaus = _plateau_sentences(summaries, study)
-    slopes = _slope_sentences(summaries)
-    notes = "".join(f"<li>{e(n)}</li>" for n in study.notes)
-    return f"""<!doctype html>
-<html lang="en"><head><meta charset="utf-8">
-<title>Accuracy against time: {e(study.scene)}</title><style>{_CSS}</style></head>
-<body>
-<h1>What accuracy costs in time: {e(study.scene)}</h1>
-<p>{study.width}×{study.height} pixels; sample counts {', '.join(str(n) for n in o.ladder())};
-{o.seeds} seeds per count; {len(study.rows)} timed renders
-(<a href="{e(files['csv'])}">{e(files['csv'])}</a>, one row per render).
-Error is measured against a converged reference: relMSE (squared error over the squared
-reference value, top 0.1 % of pixels trimmed) and SMAPE.</p>
-
-<h2>In short</h2>
-<ul>
-{''.join(f'<li>{s}</li>' for s in slopes)}
-{''.join(f'<li>{s}</li>' for s in plateaus)}
-<li>An unbiased algorithm's error halves when the samples (and so the time) double: its curve
-follows the dashed 1/N guide.  A biased algorithm's curve bends flat at its bias: past that
-point it is cheap but wrong.</li>
-</ul>
-
-<h2>Time to reach relMSE {target:g}</h2>
-<table>
-<tr><th>integrator</th><th>time to relMSE {target:g}</th><th>relMSE slope vs samples (95 %)</th>
-<th>plateau (relMSE floor)</th><th>relMSE / SMAPE</th><th>render time</th>
-<th>efficiency 1/(relMSE·s)</th></tr>
-{''.join(rows)}
-</table>
-<p class=note>Times to target are interpolated between the two rungs around the crossing
-(log time against log error); "extrapolated" uses the fitted error model a/N + c/N² + b beyond
-the ladder; "not reached" means the error levels off above the target.  The last three columns are
-at the largest sample count (mean over seeds).  Efficiency is constant for an unbiased method
-and falls once a biased one plateaus.</p>
-
-<h2>Error against time</h2>
-<img src="{e(files['time'])}" alt="relMSE and SMAPE against render time, log-log">
-<h2>Error against samples</h2>
-<img src="{e(files['samples'])}" alt="relMSE and SMAPE against samples per pixel, log-log">
-<p class=note>Markers: mean over seeds; bars: smallest and largest seed.  Thin horizontal lines:
-the fitted floor of each integrator whose error plateaus.  Cycles is measured against its own
-reference.</p>
-<h2>Equal time</h2>
-<img src="{e(files['strip'])}" alt="one render per integrator at about equal render time">
-
-<h2>How this was measured</h2>
-<ul>
-{''.join(refs)}
-<li>Error model: each integrator's mean untrimmed relMSE per sample count (the mean squared
-error, see the slope below) is fitted by a/N + c/N² + b (a, b ≥ 0, relative least squares).  b is what samples cannot remove: the algorithm's squared
-bias plus the reference's own error; c/N² accounts for the first sample of each pixel, taken at
-the pixel centre.  An integrator <i>plateaus</i> when its bias exceeds its noise at the largest
-sample count.</li>
-<li>Slope: least squares of log(relMSE − reference error) on log N over every render (all seeds)
-at the sample counts from {SLOPE_MIN_SAMPLES} on where the noise is at least {NOISE_DOMINANCE:g}×
-the bias.  Every render has its own seed, so the scatter about the line is the seed-to-seed
-spread and gives the standard error; the ± is the {100 * CONFIDENCE:.0f} % Student-t interval.
-Fewer samples are left out because both engines take the first sample of each pixel at its
-centre: it varies less than the others, so 1- to 4-sample renders are less noisy than 1/N
-predicts and the curve joins the 1/N line from below.  The slope is measured on the
-<i>untrimmed</i> relMSE (column relmse_untrimmed): trimming the worst 0.1 % of pixels removes a
-larger share of the error at few samples, where a single bright sample dominates a pixel, than
-at many, which flattens the trimmed curves a little although the mean squared error itself falls
-as 1/N.</li>
-{notes}
-</ul>
-</body></html>
-"""
-
-
-# ----------------------------------------------------------------------------
-# Everything at once
-# ----------------------------------------------------------------------------
-
-FILES = {"csv": "study.csv", "time": "error_vs_time.png", "samples": "error_vs_samples.png",
-         "strip": "equal_time.png", "html": "study.html", "markdown": "study.md",
-         "json": "study.json"}
-
-
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, (np.floating, float)):
-        return float(x) if math.isfinite(x) else None
-    if isinstance(x, np.integer):
-        return int(x)
-    if isinstance(x, np.bool_):
-        return bool(x)
-    return x
-
-
-def study_json(study: Study, summaries: dict) -> dict:
-    """The numbers of the report (no images)."""
-    return _jsonable({
-        "scene": study.scene, "width": study.width, "height": study.height,
-        "options": asdict(study.options), "ladder": study.options.ladder(),
-        "settings": study.settings, "notes": study.notes,
-        "references": {k: {"samples": r.samples, "renders": r.renders, "seconds": r.seconds,
-                           "self_relmse": r.self_relmse,
-                           "self_relmse_untrimmed": r.self_relmse_untrimmed}
-                       for k, r in study.references.items()},
-        "integrators": {k: s.to_dict() for k, s in summaries.items()},
-    })
-
-
-def write_study(study: Study, out) -> dict:
-    """Write the CSV, plots, strip, HTML, Markdown table and JSON; returns name -> path."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = {k: out / v for k, v in FILES.items()}
-    summaries = summarise(study)
-    write_csv(study.rows, paths["csv"])
-    plot_error(summaries, paths["time"], x="seconds",
-               title=f"{study.scene}: error against render time")
-    plot_error(summaries, paths["samples"], x="samples",
-               title=f"{study.scene}: error against samples per pixel")
-    equal_time_strip(study, summaries, paths["strip"])
-    paths["html"].write_text(study_html(study, summaries, FILES), encoding="utf-8")
-    paths["markdown"].write_text(
-        f"Time to reach relMSE {study.options.target_relmse:g} on {study.scene} "
-        f"({study.width}×{study.height}, {study.options.seeds} seeds):\n\n"
-        + target_table_markdown(summaries, study), encoding="utf-8")
-    paths["json"].write_text(json.dumps(study_json(study, summaries), indent=2), encoding="utf-8")
-    return paths

@@ -51,7 +51,10 @@ under test, ``b`` the reference: relative differences are ``a / b - 1``.  The
 two stacks may hold different numbers of seeds.
 
 Pure numpy and the standard library (``math.erfc``, ``math.lgamma``), so it
-runs inside Blender's Python, which has no scipy.
+runs inside Blender's Python, which has no scipy.  :func:`jsonable` (numpy to
+plain, strict-JSON Python) is here because every result of the evaluation
+package (:class:`Agreement`, the comparison report, the study summaries) is
+made JSON-ready with it.
 """
 from __future__ import annotations
 
@@ -62,7 +65,7 @@ import numpy as np
 
 __all__ = [
     "Agreement", "compare_stacks", "block_edges", "block_means",
-    "student_t_sf", "student_t_isf", "holm_adjust", "relmse", "smape",
+    "student_t_sf", "student_t_isf", "holm_adjust", "relmse", "smape", "jsonable",
 ]
 
 CHANNELS = "RGB"
@@ -514,14 +517,14 @@ def _relative(a, b):
         return np.where(b != 0, a / np.where(b != 0, b, 1.0) - 1.0, np.nan)
 
 
-def _jsonable(x):
+def jsonable(x):
     """numpy -> plain Python with NaN/inf as None (strict JSON has neither)."""
     if isinstance(x, dict):
-        return {k: _jsonable(v) for k, v in x.items()}
+        return {k: jsonable(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
+        return [jsonable(v) for v in x]
     if isinstance(x, np.ndarray):
-        return _jsonable(x.tolist())
+        return jsonable(x.tolist())
     if isinstance(x, (np.bool_, bool)):
         return bool(x)
     if isinstance(x, (np.integer, int)):
@@ -654,7 +657,7 @@ class Agreement:
                    pixels_correlated=self.pixels_correlated,
                    share_blocks_differ=self.share_blocks_differ,
                    differing_blocks=self.differing_blocks(), summary=self.summary())
-        return _jsonable(out)
+        return jsonable(out)
 
 
 # ----------------------------------------------------------------------------

@@ -1,12 +1,13 @@
-"""Accuracy against time on a Blender scene: the bpy half of :mod:`mcengine.study`.
+"""Accuracy against time on a Blender scene: the bpy half of :mod:`mcengine.evaluation.study`.
 
 ``study_scene`` renders the scene as it is in memory (saved or not) with each
 of MC Engine's integrators, and with Cycles if asked, at a ladder of sample
 counts and several seeds, and hands the timed images to
-:func:`mcengine.study.run_study`, which measures the errors; the scene's
-settings are restored afterwards.  ``study_file`` does the same for a .blend
-on disk.  The command line (``mcengine study``) and the "Study Accuracy vs
-Time" operator go through here.
+:func:`mcengine.evaluation.study.run_study`, which measures the errors; the
+scene's settings are restored afterwards.  ``study_file`` does the same for a
+.blend on disk.  The command line (``mcengine study``) and the "Study Accuracy
+vs Time" operator go through here; :mod:`mcengine.evaluation.output` writes
+the files.
 
 Settings: the comparison's matched, unbiased settings
 (``comparison.matched_settings``: denoising, adaptive sampling, clamping,
@@ -16,7 +17,7 @@ to Whitted and distribution ray tracing (Whitted keeps the scene's depth when
 it is not given), ``branching`` to distribution ray tracing.
 
 Timing: each render's ``seconds`` is the wall time of the render operator
-alone (``batch.render_scene``): for MC Engine the scene export, BVH build,
+alone (``render.render_scene``): for MC Engine the scene export, BVH build,
 kernel set-up, tracing and shading; for Cycles its scene sync, BVH build and
 rendering; for both, writing the image to a temporary 32-bit EXR.  Loading
 the file, reading the image back and measuring the error are not counted.
@@ -28,9 +29,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from mcengine.study import CYCLES, Study, StudyError, StudyOptions, run_study
+from mcengine.evaluation.study import CYCLES, Study, StudyError, StudyOptions, run_study
+from mcengine.integrators import INTEGRATORS, get as get_integrator
 
-from . import batch
+from .comparison import matched_settings
+from .render import OpenError, ensure_registered, error_message, open_scene, render_scene
+from .settings import apply_overrides, restoring
 
 __all__ = ["DISTRIBUTION_DEPTH", "DISTRIBUTION_BRANCHING", "StudySettings", "study_scene",
            "study_file", "TIMING_NOTE"]
@@ -42,11 +46,6 @@ __all__ = ["DISTRIBUTION_DEPTH", "DISTRIBUTION_BRANCHING", "StudySettings", "stu
 # with fewer levels the missing bounces dominate the error.
 DISTRIBUTION_DEPTH = 3
 DISTRIBUTION_BRANCHING = 4
-
-# scene.mcengine values for each of the study's integrator names.
-_ENUM = {"path": "PATH", "raycast": "RAYCAST", "whitted": "WHITTED",
-         "distribution": "DISTRIBUTION"}
-_OWN_SETTINGS = ("integrator", "depth", "branching")
 
 TIMING_NOTE = (
     "Render times are the wall time of Blender's render operator alone: for MC Engine the "
@@ -73,108 +72,94 @@ class StudySettings:
 
 
 def _integrator_settings(scene, settings: StudySettings) -> dict:
-    """Integrator -> (depth, branching) it renders with."""
+    """Integrator -> (depth, branching) it renders with.
+
+    The one that branches (distribution ray tracing) gets the study's defaults
+    above; the others get the depth given (else the scene's) and the scene's
+    branching, of which only Whitted reads anything: its depth.
+    """
     own = scene.mcengine
-    whitted_depth = settings.depth or own.depth
-    return {"path": (own.depth, own.branching), "raycast": (1, own.branching),
-            "whitted": (whitted_depth, own.branching),
-            "distribution": (settings.depth or DISTRIBUTION_DEPTH,
-                             settings.branching or DISTRIBUTION_BRANCHING)}
+    chosen = {}
+    for name, info in INTEGRATORS.items():
+        if info.uses_branching:
+            chosen[name] = (settings.depth or DISTRIBUTION_DEPTH,
+                            settings.branching or DISTRIBUTION_BRANCHING)
+        else:
+            chosen[name] = (settings.depth or own.depth, own.branching)
+    return chosen
 
 
 def _descriptions(chosen: dict, integrators) -> dict:
-    """Integrator -> one-line description of its settings, for the report."""
+    """Integrator -> one-line description of the settings it uses, for the report."""
     out = {}
-    if "whitted" in integrators:
-        out["whitted"] = f"depth {chosen['whitted'][0]}"
-    if "distribution" in integrators:
-        depth, b = chosen["distribution"]
-        rays = sum(b ** k for k in range(depth))
-        out["distribution"] = f"depth {depth}, branching {b}: up to {rays} rays per sample"
+    for name in integrators:
+        text = get_integrator(name).settings_text(*chosen[name])
+        if text:
+            out[name] = text
     return out
 
 
 def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySettings = StudySettings(),
-                *, name: str | None = None, render=batch.render_scene, on_render=None) -> Study:
+                *, name: str | None = None, render=render_scene, on_render=None) -> Study:
     """Study ``scene`` (left as it was afterwards).
 
     Parameters
     ----------
     scene : bpy.types.Scene
-    options : mcengine.study.StudyOptions
+    options : mcengine.evaluation.study.StudyOptions
     settings : StudySettings
     name : str, optional
         Name in the report; default the scene's name.
     render : callable
-        ``render(scene, engine, samples=, seed=) -> batch.Render``; the command
+        ``render(scene, engine, samples=, seed=) -> render.Render``; the command
         line passes one that shows progress.
     on_render : callable, optional
         ``on_render(label, index, total)`` before each render (index from 0).
 
     Returns
     -------
-    mcengine.study.Study
+    mcengine.evaluation.study.Study
 
     Raises
     ------
     StudyError
         On invalid options or a failed render (with the engine's message).
     """
-    from .cli import error_message
-    from .comparison import matched_settings
-
     options.validate()
-    batch.ensure_registered()
-    own = scene.mcengine
-    saved = {key: getattr(own, key) for key in _OWN_SETTINGS}
-    threads = scene.render.threads_mode, scene.render.threads
+    ensure_registered()
     chosen = _integrator_settings(scene, settings)
-    try:
-        with batch.restoring(scene):
-            matched_settings(scene)
-            if settings.resolution is not None:
-                scene.render.resolution_x, scene.render.resolution_y = settings.resolution
-                scene.render.resolution_percentage = 100
-            if settings.threads is not None:
-                scene.render.threads_mode = "AUTO" if settings.threads == 0 else "FIXED"
-                if settings.threads:
-                    scene.render.threads = settings.threads
+    with restoring(scene):
+        matched_settings(scene)
+        apply_overrides(scene, resolution=settings.resolution, threads=settings.threads)
 
-            def render_one(integrator, samples, seed):
-                engine = "cycles" if integrator == CYCLES else "mcengine"
-                if engine == "mcengine":
-                    own.integrator = _ENUM[integrator]
-                    own.depth, own.branching = chosen[integrator]
-                try:
-                    return render(scene, engine, samples=samples, seed=seed)
-                except RuntimeError as exc:
-                    raise StudyError(f"{integrator} render failed: {error_message(exc)}") from None
+        def render_one(integrator, samples, seed):
+            engine = "cycles" if integrator == CYCLES else "mcengine"
+            if engine == "mcengine":
+                depth, branching = chosen[integrator]
+                apply_overrides(scene, integrator=integrator, depth=depth, branching=branching)
+            try:
+                return render(scene, engine, samples=samples, seed=seed)
+            except RuntimeError as exc:
+                raise StudyError(f"{integrator} render failed: {error_message(exc)}") from None
 
-            study = run_study(render_one, options, scene=name or scene.name,
-                              settings=_descriptions(chosen, options.integrators),
-                              notes=[TIMING_NOTE], on_render=on_render)
-    finally:
-        for key, value in saved.items():
-            if getattr(own, key) != value:
-                setattr(own, key, value)
-        if (scene.render.threads_mode, scene.render.threads) != threads:
-            scene.render.threads_mode, scene.render.threads = threads
-    if options.integrators and own.last_ignored:
+        study = run_study(render_one, options, scene=name or scene.name,
+                          settings=_descriptions(chosen, options.integrators),
+                          notes=[TIMING_NOTE], on_render=on_render)
+    ignored = scene.mcengine.last_ignored
+    if options.integrators and ignored:
         study.notes.append(f"MC Engine does not support, and rendered without: "
-                           f"{own.last_ignored}. Its reference leaves them out too, so its "
+                           f"{ignored}. Its reference leaves them out too, so its "
                            f"errors measure its own convergence, not its agreement with Cycles.")
     return study
 
 
 def study_file(path, options: StudyOptions = StudyOptions(),
                settings: StudySettings = StudySettings(), *, scene_name: str | None = None,
-               render=batch.render_scene, on_render=None) -> Study:
+               render=render_scene, on_render=None) -> Study:
     """Open ``path`` and :func:`study_scene` it; the report is named after the file."""
-    from .comparison import CompareError, open_scene
     try:
         scene = open_scene(path, scene_name)
-    except CompareError as exc:
+    except OpenError as exc:
         raise StudyError(str(exc)) from None
     return study_scene(scene, options, settings, name=Path(path).stem, render=render,
                        on_render=on_render)
-

@@ -2,11 +2,11 @@
 
 ``compare_scene`` renders the scene in memory (saved or not) ``K`` times with
 each engine under matched settings, restores the scene's settings afterwards
-and hands the pixels to :mod:`mcengine.report`, which computes the verdict and
-writes the files.  ``compare_file`` does the same for a .blend on disk and
-``run_suite`` for every .blend in a folder.  The command line (``mcengine
-compare``), the "Compare with Cycles" operator and the fidelity tests all go
-through here.
+and hands the pixels to :func:`mcengine.evaluation.comparison.build_comparison`,
+which computes the verdict; :mod:`mcengine.evaluation.output` writes the
+files.  ``compare_file`` does the same for a .blend on disk and ``run_suite``
+for every .blend in a folder.  The command line (``mcengine compare``), the
+"Compare with Cycles" operator and the fidelity tests all go through here.
 
 Matched settings (both engines read Cycles' settings): the same resolution,
 samples and bounces; denoising, adaptive sampling, clamping, Filter Glossy
@@ -22,15 +22,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from mcengine.report import (EngineRuns, SuiteRow, build_comparison, suite_row,
-                             write_comparison, write_suite)
+from mcengine.evaluation.comparison import EngineRuns, SuiteRow, build_comparison, suite_row
+from mcengine.evaluation.output import write_comparison, write_suite
+from mcengine.integrators import INTEGRATORS
 
-from . import batch
+from .render import ENGINES, OpenError, ensure_registered, error_message, open_scene, render_scene
+from .settings import apply_overrides, make_unbiased, restoring
 
 __all__ = ["CompareOptions", "CompareError", "compare_scene", "compare_file", "render_runs",
-           "open_scene", "suite_files", "run_suite", "render_size", "matched_settings"]
+           "suite_files", "run_suite", "render_size", "matched_settings"]
 
-ENGINES = ("mcengine", "cycles")
+# The two engines of a comparison, in the order of the statistics' stacks a and b.
+COMPARED = tuple(ENGINES)        # ("mcengine", "cycles")
+# MC Engine's integrator in a comparison: the one that matches Cycles (path tracing).
+INTEGRATOR = next(name for name, info in INTEGRATORS.items() if info.matches_cycles)
 
 
 class CompareError(Exception):
@@ -82,22 +87,15 @@ def render_size(scene, options: CompareOptions) -> tuple:
 
 def matched_settings(scene) -> dict:
     """Apply the matched settings; returns the ones recorded in the report."""
-    batch.make_unbiased(scene)
+    make_unbiased(scene)
     cycles = scene.cycles
     cycles.time_limit = 0.0
     cycles.use_layer_samples = "IGNORE"
-    scene.mcengine.integrator = "PATH"
+    apply_overrides(scene, integrator=INTEGRATOR)
     return {"max_bounces": cycles.max_bounces, "diffuse_bounces": cycles.diffuse_bounces,
             "pixel_filter": f"{cycles.pixel_filter_type} {cycles.filter_width:g} px",
             "view_transform": scene.view_settings.view_transform,
             "denoising, adaptive sampling, clamping": "off"}
-
-
-def _one_line(exc: Exception) -> str:
-    """A bpy RuntimeError's text as one line, without Blender's "Error:" prefixes."""
-    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
-    lines = [line[len("Error:"):].strip() if line.startswith("Error:") else line for line in lines]
-    return "; ".join(dict.fromkeys(lines)) or type(exc).__name__
 
 
 def _render_runs(scene, engine: str, options: CompareOptions, size, render, on_render,
@@ -112,7 +110,7 @@ def _render_runs(scene, engine: str, options: CompareOptions, size, render, on_r
         try:
             renders.append(render(scene, engine, samples=samples, seed=seed, resolution=size))
         except RuntimeError as exc:
-            raise CompareError(f"{engine} render failed: {_one_line(exc)}") from None
+            raise CompareError(f"{engine} render failed: {error_message(exc)}") from None
     notes = []
     if engine == "mcengine":
         ignored = getattr(getattr(scene, "mcengine", None), "last_ignored", "")
@@ -131,22 +129,22 @@ def _check_seeds(options: CompareOptions) -> None:
 
 
 def render_runs(scene, engine: str, options: CompareOptions = CompareOptions(), *,
-                render=batch.render_scene, on_render=None) -> EngineRuns:
+                render=render_scene, on_render=None) -> EngineRuns:
     """One engine's K renders of ``scene`` under the matched settings (scene restored).
 
     For comparisons the caller assembles itself, e.g. a deliberately altered
     scene against the original, or Cycles against Cycles with other seeds.
     """
     _check_seeds(options)
-    batch.ensure_registered()
-    with batch.restoring(scene):
+    ensure_registered()
+    with restoring(scene):
         matched_settings(scene)
         return _render_runs(scene, engine, options, render_size(scene, options), render,
                             on_render)
 
 
 def compare_scene(scene, options: CompareOptions = CompareOptions(), *, name: str | None = None,
-                  render=batch.render_scene, on_render=None):
+                  render=render_scene, on_render=None):
     """Render ``scene`` with both engines and compare (the scene is left as it was).
 
     Parameters
@@ -157,14 +155,14 @@ def compare_scene(scene, options: CompareOptions = CompareOptions(), *, name: st
     name : str, optional
         Name in the report; default the scene's name.
     render : callable
-        ``render(scene, engine, samples=, seed=, resolution=) -> batch.Render``;
+        ``render(scene, engine, samples=, seed=, resolution=) -> render.Render``;
         the command line passes one that shows progress.
     on_render : callable, optional
         ``on_render(engine, index, total)`` before each render (index from 0).
 
     Returns
     -------
-    mcengine.report.Comparison
+    mcengine.evaluation.comparison.Comparison
 
     Raises
     ------
@@ -172,38 +170,25 @@ def compare_scene(scene, options: CompareOptions = CompareOptions(), *, name: st
         If a render fails (with the engine's message) or the image is too small.
     """
     _check_seeds(options)
-    batch.ensure_registered()
-    total = len(ENGINES) * options.seeds
-    with batch.restoring(scene):
+    ensure_registered()
+    total = len(COMPARED) * options.seeds
+    with restoring(scene):
         settings = matched_settings(scene)
         size = render_size(scene, options)
         runs = [_render_runs(scene, engine, options, size, render, on_render,
                              first_index=e * options.seeds, total=total)
-                for e, engine in enumerate(ENGINES)]
+                for e, engine in enumerate(COMPARED)]
     return build_comparison(name or scene.name, *runs, grid=options.grid, alpha=options.alpha,
                             settings=settings)
 
 
-def open_scene(path, scene_name: str | None = None):
-    """Load a .blend and return its active scene (or the one named)."""
-    import bpy
-    try:
-        scene = batch.open_blend(path)
-    except RuntimeError as exc:
-        raise CompareError(f"cannot open {path}: {_one_line(exc)}") from None
-    if scene_name is not None:
-        scene = bpy.data.scenes.get(scene_name)
-        if scene is None:
-            names = ", ".join(s.name for s in bpy.data.scenes)
-            raise CompareError(f"no scene named {scene_name!r} in {Path(path).name} "
-                               f"(scenes: {names})")
-    return scene
-
-
 def compare_file(path, options: CompareOptions = CompareOptions(), *,
-                 scene_name: str | None = None, render=batch.render_scene, on_render=None):
+                 scene_name: str | None = None, render=render_scene, on_render=None):
     """Open ``path`` and :func:`compare_scene` it; the report is named after the file."""
-    scene = open_scene(path, scene_name)
+    try:
+        scene = open_scene(path, scene_name)
+    except OpenError as exc:
+        raise CompareError(str(exc)) from None
     return compare_scene(scene, options, name=Path(path).stem, render=render, on_render=on_render)
 
 
@@ -212,7 +197,7 @@ def suite_files(folder) -> list:
     return sorted(p for p in Path(folder).glob("*.blend") if p.is_file())
 
 
-def run_suite(folder, options: CompareOptions, out_dir, *, render=batch.render_scene,
+def run_suite(folder, options: CompareOptions, out_dir, *, render=render_scene,
               on_scene=None, on_render=None, on_done=None):
     """Compare every .blend in ``folder``; write per-scene folders and the summary.
 
@@ -232,7 +217,7 @@ def run_suite(folder, options: CompareOptions, out_dir, *, render=batch.render_s
     -------
     rows : list of SuiteRow
     paths : dict
-        The summary files written (see :func:`mcengine.report.write_suite`).
+        The summary files written (see :func:`mcengine.evaluation.output.write_suite`).
     """
     out = Path(out_dir)
     rows = []

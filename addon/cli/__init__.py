@@ -1,0 +1,104 @@
+"""Command line: render a .blend file headless with MC Engine or Cycles, compare the two,
+or study what accuracy costs in time.
+
+Two spellings take the same options::
+
+    mcengine render SCENE.blend [--engine mcengine|cycles] [--samples N] [--resolution WxH]
+                                [--seed S] [--frame F] [-o OUT.exr|OUT.png ...] [-F FORMAT]
+                                [--integrator path|raycast|whitted|distribution]
+                                [--depth R] [--branching B]
+    mcengine -b SCENE.blend -E MCENGINE -o /tmp/out_#### -F OPEN_EXR -f 1
+
+The second one is Blender's own background-render syntax (``-b -E -o -f -F -S -t``
+and their long forms), so ``blender -b`` scripts carry over unchanged.
+
+``compare`` renders a scene with both engines and tests whether they agree
+(see ``mcengine_blender.batch.comparison`` and ``mcengine.evaluation``)::
+
+    mcengine compare SCENE.blend [--samples N] [--resolution WxH|P%] [--seeds K] [--out DIR]
+    mcengine compare --suite FOLDER [same options]      # every .blend in FOLDER, one summary
+
+``study`` renders a ladder of sample counts with each integrator (and Cycles)
+and reports error against time (see ``mcengine_blender.batch.study`` and
+``mcengine.evaluation.study``)::
+
+    mcengine study SCENE.blend [--out DIR] [--max-samples N] [--integrators path,raycast,...]
+                               [--with-cycles] [--seeds K] [--resolution WxH]
+                               [--depth R] [--branching B] [--target RELMSE]
+
+Conventions
+-----------
+* Every argument, the input file (its magic bytes) and the output folders are
+  checked before ``bpy`` is imported, so bad input fails in well under a second.
+* Failures are one line on stderr, ``mcengine: error: ...``, never a traceback.
+  Exit status: 0 rendered, 1 the render (or file loading) failed, 2 bad input;
+  ``compare`` exits 0 when the engines agree and 3 when they differ (1 and 2 as
+  above; in a suite, any failed scene gives 1, else any difference 3).
+* Output paths follow Blender: ``//`` is the .blend file's folder, the last run
+  of ``#`` in the file name becomes the zero-padded frame number, and the
+  format's extension is appended when the name has none.  ``-o`` may be given
+  several times to save the same render in several formats.
+* Overrides change this render only, never the file.  Samples go to
+  ``scene.cycles.samples`` and the seed to ``scene.cycles.seed`` (MC Engine reads
+  Cycles' sampling settings); ``--resolution`` sets x, y and 100 %.
+* EXR output is OPEN_EXR, 32-bit float RGBA, scene-linear, with the file's EXR
+  codec; PNG output is 8-bit RGBA through the file's view transform.
+* Blender's own log is captured: shown with ``--verbose`` or when a render fails,
+  otherwise only its ``Warning:`` lines are passed on.
+* Progress goes to stderr: a bar redrawn in place on a terminal, one line per
+  10 % otherwise.  It parses ``Sample N/M`` from the render statistics
+  (``bpy.app.handlers.render_stats``), which Cycles reports and which a Python
+  engine reports through ``RenderEngine.update_stats``; ``update_progress`` does
+  not reach Python handlers in Blender 5.0.
+* After an MC Engine render one line of ray accounting goes to stderr: rays
+  per pixel by kind, Mrays/s and the time of each phase.
+* The only thing written to stdout is the path of each saved image (``compare``:
+  the path of each ``report.json``, or of ``summary.json`` for a suite;
+  ``study``: the path of ``study.html``).
+
+Layout
+------
+* ``args``: the parser, the validators and the requests they produce (no bpy);
+* ``console``: Blender's log captured, the progress display;
+* ``commands``: what ``render``, ``compare`` and ``study`` do (bpy from here on);
+* ``errors``: the program name, the exit statuses and the one-line error;
+* ``main`` (here) ties them together; ``python -m mcengine_blender.cli`` and
+  the ``mcengine`` console script both call it.
+"""
+from __future__ import annotations
+
+import sys
+import traceback
+
+from .args import CompareRequest, StudyRequest, parse_args
+from .commands import run_compare, run_render, run_study
+from .errors import EXIT_INTERRUPTED, EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
+
+__all__ = ["main"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Console entry point; returns the exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    verbose = "--verbose" in argv
+    try:
+        request = parse_args(argv)
+        if request is None:
+            return EXIT_OK
+        if isinstance(request, CompareRequest):
+            return run_compare(request)
+        if isinstance(request, StudyRequest):
+            return run_study(request)
+        return run_render(request)
+    except CliError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # last resort: still one line unless asked for details
+        if verbose:
+            traceback.print_exc()
+        print(f"{PROG}: error: internal error: {type(exc).__name__}: {exc} "
+              "(run with --verbose for the traceback)", file=sys.stderr)
+        return EXIT_RENDER_FAILED

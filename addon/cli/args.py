@@ -1,0 +1,633 @@
+"""The command line's arguments: parsed and checked without Blender.
+
+:func:`parse_args` turns ``argv`` into a validated request, one of
+:class:`RenderRequest`, :class:`CompareRequest` and :class:`StudyRequest`, or
+raises :class:`~.errors.CliError` with a one-line message.  Every argument,
+the input file (its magic bytes) and the output folders are checked here,
+before ``bpy`` is imported, so bad input fails in well under a second.
+Blender's own ``-b FILE ...`` syntax is rewritten to ``render FILE ...``.
+Output paths follow Blender (``//``, ``#`` frame digits, the format's
+extension appended).
+"""
+from __future__ import annotations
+
+import argparse
+import gzip
+import math
+import os
+import re
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from mcengine.evaluation.study import (DEFAULT_MAX_SAMPLES, DEFAULT_SEEDS as STUDY_SEEDS,
+                                       DEFAULT_TARGET_RELMSE, REFERENCE_RENDERS)
+from mcengine.integrators import (BRANCHING_RANGE, DEFAULT as DEFAULT_INTEGRATOR, DEPTH_RANGE,
+                                  INTEGRATORS, NAMES as INTEGRATOR_NAMES)
+
+from ..batch.render import ENGINES
+from .errors import PROG, CliError
+
+__all__ = ["RenderRequest", "CompareRequest", "StudyRequest", "Output", "parse_args",
+           "build_parser", "check_blend_file", "check_output_folder", "prepare_output_folder",
+           "frame_path"]
+
+DEFAULT_ENGINE = ENGINES["mcengine"]
+
+
+# Blender image format -> file extension.  Only the two formats whose pixel
+# meaning is unambiguous are offered: linear float EXR and display-referred PNG.
+FORMATS = {"OPEN_EXR": ".exr", "PNG": ".png"}
+DEFAULT_FORMAT = "OPEN_EXR"
+# Extensions of other image formats: a name ending in one of these is a mistake,
+# not a name to which ".exr" should be appended.
+OTHER_IMAGE_EXTENSIONS = {".jpg", ".jpeg", ".tif", ".tiff", ".hdr", ".bmp", ".tga",
+                          ".webp", ".jp2", ".dpx", ".cin", ".rgb", ".sgi", ".mp4", ".mkv"}
+
+# Blender's hard limits (RNA ranges of RenderSettings, CyclesRenderSettings, Scene).
+MIN_RESOLUTION, MAX_RESOLUTION = 4, 65536
+MAX_SAMPLES = 16_777_216
+MAX_SEED = 2_147_483_647
+MAX_FRAME = 1_048_574
+MAX_THREADS = 1024
+# compare: renders per engine.  Two is the minimum that estimates the noise;
+# more than this is never needed (the test pools every pixel's variance).
+DEFAULT_SEEDS, MAX_SEEDS = 2, 64     # the study's default is its own (STUDY_SEEDS)
+MAX_PERCENTAGE = 1000
+DEFAULT_ALPHA = 1e-3
+# The comparison tests an 8x8 grid of blocks, so each side needs 8 pixels.
+MIN_COMPARE_SIZE = 8
+# study: the ladder's largest sample count (25 rungs at most, see mcengine.evaluation.study).
+MAX_STUDY_SAMPLES = 1 << 24
+
+# A .blend starts with "BLENDER"; Blender 3.0+ may zstd-compress the whole file,
+# older versions gzip it.
+BLEND_MAGIC = b"BLENDER"
+ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+GZIP_MAGIC = b"\x1f\x8b"
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises instead of printing usage and exiting."""
+
+    def error(self, message):
+        raise CliError(message)
+
+
+def _positive_int(text: str, what: str, maximum: int, minimum: int = 1) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what} must be a whole number, got {text!r}") from None
+    if not minimum <= value <= maximum:
+        raise argparse.ArgumentTypeError(f"{what} must be between {minimum} and {maximum}, "
+                                         f"got {value}")
+    return value
+
+
+def _samples(text: str) -> int:
+    return _positive_int(text, "sample count", MAX_SAMPLES)
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed must be a whole number, got {text!r}") from None
+    if not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"seed must be between 0 and {MAX_SEED}, got {value}")
+    return value
+
+
+def _frame(text: str) -> int:
+    if text[:1] in "+-" or not text.isdigit():
+        raise argparse.ArgumentTypeError(
+            f"frame must be one absolute frame number, got {text!r} "
+            "(relative frames and ranges are not supported)")
+    value = int(text)
+    if value > MAX_FRAME:
+        raise argparse.ArgumentTypeError(f"frame must be at most {MAX_FRAME}, got {value}")
+    return value
+
+
+def _threads(text: str) -> int:
+    if text == "0":
+        return 0
+    return _positive_int(text, "thread count", MAX_THREADS)
+
+
+def _resolution(text: str) -> tuple[int, int]:
+    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not match:
+        raise argparse.ArgumentTypeError(f"resolution must look like 640x480, got {text!r}")
+    width, height = int(match[1]), int(match[2])
+    for size in (width, height):
+        if not MIN_RESOLUTION <= size <= MAX_RESOLUTION:
+            raise argparse.ArgumentTypeError(
+                f"resolution {width}x{height} is outside Blender's range "
+                f"{MIN_RESOLUTION}..{MAX_RESOLUTION} per side")
+    return width, height
+
+
+def _engine(text: str) -> str:
+    idname = ENGINES.get(text.lower())
+    if idname is None:
+        raise argparse.ArgumentTypeError(
+            f"unknown engine {text!r} (choose from {', '.join(ENGINES)})")
+    return idname
+
+
+def _integrator(text: str) -> str:
+    name = text.lower()
+    if name not in INTEGRATORS:
+        raise argparse.ArgumentTypeError(
+            f"unknown integrator {text!r} (choose from {', '.join(INTEGRATOR_NAMES)})")
+    return name
+
+
+def _integrator_list(text: str) -> tuple[str, ...]:
+    names = tuple(_integrator(part.strip()) for part in text.split(",") if part.strip())
+    if not names:
+        raise argparse.ArgumentTypeError("--integrators needs at least one name, e.g. path,raycast")
+    if len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"an integrator is listed twice in {text!r}")
+    return names
+
+
+def _depth(text: str) -> int:
+    return _positive_int(text, "depth", DEPTH_RANGE[1], DEPTH_RANGE[0])
+
+
+def _branching(text: str) -> int:
+    return _positive_int(text, "branching", BRANCHING_RANGE[1], BRANCHING_RANGE[0])
+
+
+def _readers(parameter: str) -> list[str]:
+    """Names of the integrators that read ``parameter`` ("depth" or "branching")."""
+    return [name for name, info in INTEGRATORS.items() if getattr(info, f"uses_{parameter}")]
+
+
+def _in_words(names) -> str:
+    """'a', 'a and b', 'a, b or c'."""
+    names = list(names)
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " or " + names[-1]
+
+
+def _add_integrator_options(parser, for_study: bool = False) -> None:
+    """--depth and --branching (and --integrator for a render)."""
+    if not for_study:
+        choices = [f"{name} (default)" if name == DEFAULT_INTEGRATOR else name
+                   for name in INTEGRATOR_NAMES]
+        parser.add_argument("--integrator", type=_integrator, default=None,
+                            help=f"MC Engine's algorithm: {_in_words(choices)} "
+                                 "(default: the file's setting)")
+    parser.add_argument("--depth", type=_depth, default=None, metavar="R",
+                        help=f"ray levels of {' and '.join(_readers('depth'))}, "
+                             f"{DEPTH_RANGE[0]}..{DEPTH_RANGE[1]} (the camera ray is level 1)")
+    parser.add_argument("--branching", type=_branching, default=None, metavar="B",
+                        help=f"rays per hit of {' and '.join(_readers('branching'))}, "
+                             f"{BRANCHING_RANGE[0]}..{BRANCHING_RANGE[1]}")
+
+
+def _check_integrator_options(integrators, depth, branching, engine=None) -> None:
+    """One-line errors for options that the chosen integrators would ignore."""
+    if engine == ENGINES["cycles"] and (integrators or depth or branching):
+        raise CliError("--integrator, --depth and --branching choose MC Engine's algorithm; "
+                       "they do not apply to --engine cycles")
+    if not integrators:
+        return
+    for option, value in (("depth", depth), ("branching", branching)):
+        readers = _readers(option)
+        if value is not None and not set(readers) & set(integrators):
+            plural = "s" if len(readers) > 1 else ""
+            raise CliError(f"--{option} applies to the {' and '.join(readers)} "
+                           f"integrator{plural} only")
+
+
+def _format(text: str) -> str:
+    name = text.upper()
+    if name not in FORMATS:
+        raise argparse.ArgumentTypeError(
+            f"unsupported format {text!r} (choose from {', '.join(FORMATS)})")
+    return name
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``mcengine`` parser with its ``render`` subcommand."""
+    parser = _Parser(
+        prog=PROG,
+        description="Render .blend files with MC Engine (or Cycles) from the command line. "
+                    f"Blender's syntax also works: {PROG} -b SCENE.blend -E MCENGINE -o OUT -f 1",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    render = commands.add_parser(
+        "render", help="render one frame of a .blend file",
+        description="Render one frame of a .blend file and save it as EXR and/or PNG.")
+    render.add_argument("blendfile", metavar="SCENE.blend", help="the file to render")
+    render.add_argument("-E", "--engine", type=_engine, default=None,
+                        help="mcengine (default) or cycles; Blender's MCENGINE/CYCLES also work")
+    render.add_argument("--samples", type=_samples, default=None,
+                        help="samples per pixel (default: the file's Cycles samples)")
+    render.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
+                        help="image size in pixels, at 100%% (default: the file's)")
+    render.add_argument("--seed", type=_seed, default=None,
+                        help="sampling seed (default: the file's Cycles seed)")
+    render.add_argument("-f", "--frame", "--render-frame", dest="frame", type=_frame,
+                        default=None, metavar="F", help="frame to render (default: the file's current frame)")
+    render.add_argument("-o", "--output", "--render-output", dest="outputs", action="append",
+                        default=None, metavar="PATH",
+                        help="output image; .exr or .png, '//' = folder of the .blend, "
+                             "'#' = frame digits; repeat to save several formats "
+                             "(default: ./SCENE.exr)")
+    render.add_argument("-F", "--render-format", dest="format", type=_format, default=None,
+                        metavar="FORMAT", help="OPEN_EXR or PNG (default: from the extension, else OPEN_EXR)")
+    render.add_argument("-S", "--scene", default=None, help="scene to render (default: the file's active scene)")
+    render.add_argument("-t", "--threads", type=_threads, default=None,
+                        help="CPU threads, 0 = all (default: the file's setting)")
+    _add_integrator_options(render)
+    render.add_argument("--verbose", action="store_true",
+                        help="show Blender's own log and tracebacks")
+    _add_compare_parser(commands)
+    _add_study_parser(commands)
+    return parser
+
+
+def _add_compare_parser(commands) -> None:
+    compare = commands.add_parser(
+        "compare", help="render with MC Engine and Cycles and test whether they agree",
+        description="Render a scene with MC Engine and with Cycles under matched, unbiased "
+                    "settings, K seeds each, and test whether the two agree within their noise. "
+                    "Writes mcengine.exr, cycles.exr, side_by_side.png, report.json and report.md. "
+                    "Exit status 0: agree, 3: differ.")
+    compare.add_argument("blendfile", metavar="SCENE.blend", nargs="?", default=None,
+                         help="the file to compare (or use --suite)")
+    compare.add_argument("--suite", metavar="FOLDER", default=None,
+                         help="compare every .blend in FOLDER and write summary.md/.html/.json")
+    compare.add_argument("--samples", type=_samples, default=None,
+                         help="samples per pixel and render (default: the file's Cycles samples)")
+    compare.add_argument("--resolution", type=_compare_resolution, default=None, metavar="WxH|P%",
+                         help="image size in pixels, or a percentage of the file's size "
+                              "(default: the file's size and percentage)")
+    compare.add_argument("--seeds", type=_seeds, default=DEFAULT_SEEDS, metavar="K",
+                         help=f"renders per engine, {2}..{MAX_SEEDS} (default {DEFAULT_SEEDS})")
+    compare.add_argument("--alpha", type=_alpha, default=DEFAULT_ALPHA,
+                         help=f"false-alarm rate of the verdict over all its tests "
+                              f"(default {DEFAULT_ALPHA:g})")
+    compare.add_argument("--out", metavar="DIR", default=None,
+                         help="output folder, created if missing "
+                              "(default: ./compare-SCENE, or ./compare-suite)")
+    compare.add_argument("-S", "--scene", default=None,
+                         help="scene to compare (default: the file's active scene)")
+    compare.add_argument("-t", "--threads", type=_threads, default=None,
+                         help="CPU threads, 0 = all (default: the file's setting)")
+    compare.add_argument("--verbose", action="store_true",
+                         help="show Blender's own log and tracebacks")
+
+
+def _add_study_parser(commands) -> None:
+    study = commands.add_parser(
+        "study", help="measure what accuracy costs in time, per integrator and for Cycles",
+        description="Render the scene at 1, 2, 4, ... N samples per pixel with each integrator "
+                    "(and Cycles), several seeds each, time every render and measure its error "
+                    "against a converged reference. Writes study.csv, error_vs_time.png, "
+                    "error_vs_samples.png, equal_time.png, study.html, study.md and study.json.")
+    study.add_argument("blendfile", metavar="SCENE.blend", help="the file to study")
+    study.add_argument("--out", metavar="DIR", default=None,
+                       help="output folder, created if missing (default: ./study-SCENE)")
+    study.add_argument("--max-samples", type=_study_samples, default=DEFAULT_MAX_SAMPLES,
+                       metavar="N", help=f"largest sample count of the ladder "
+                                         f"(default {DEFAULT_MAX_SAMPLES})")
+    study.add_argument("--integrators", type=_integrator_list, default=INTEGRATOR_NAMES,
+                       metavar="LIST", help="comma-separated, from " + ",".join(INTEGRATOR_NAMES)
+                                            + " (default: all)")
+    study.add_argument("--with-cycles", action="store_true",
+                       help="also study Cycles, against its own reference")
+    study.add_argument("--seeds", type=_seeds, default=STUDY_SEEDS, metavar="K",
+                       help=f"renders per sample count, 2..{MAX_SEEDS} (default {STUDY_SEEDS})")
+    study.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
+                       help="image size in pixels (default: the file's size and percentage)")
+    study.add_argument("--target", type=_target, default=DEFAULT_TARGET_RELMSE,
+                       metavar="RELMSE", help=f"relMSE whose time to reach is reported "
+                                              f"(default {DEFAULT_TARGET_RELMSE:g})")
+    study.add_argument("--reference-samples", type=_samples, default=None, metavar="M",
+                       help="samples per pixel of each reference (default: 16 x N)")
+    _add_integrator_options(study, for_study=True)
+    study.add_argument("-S", "--scene", default=None,
+                       help="scene to study (default: the file's active scene)")
+    study.add_argument("-t", "--threads", type=_threads, default=None,
+                       help="CPU threads, 0 = all (default: the file's setting)")
+    study.add_argument("--verbose", action="store_true",
+                       help="show Blender's own log and tracebacks")
+
+
+def _study_samples(text: str) -> int:
+    return _positive_int(text, "largest sample count", MAX_STUDY_SAMPLES)
+
+
+def _target(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"target must be a number, got {text!r}") from None
+    if not 0.0 < value < math.inf:
+        raise argparse.ArgumentTypeError(f"target relMSE must be positive, got {value:g}")
+    return value
+
+
+def _compare_resolution(text: str):
+    """``WxH`` -> ("size", (w, h)); ``P%`` -> ("percent", P)."""
+    match = re.fullmatch(r"\s*(\d+)\s*%\s*", text)
+    if match is None:
+        return "size", _resolution(text)
+    percent = int(match[1])
+    if not 1 <= percent <= MAX_PERCENTAGE:
+        raise argparse.ArgumentTypeError(
+            f"resolution percentage must be between 1 and {MAX_PERCENTAGE}, got {percent}")
+    return "percent", percent
+
+
+def _seeds(text: str) -> int:
+    value = _positive_int(text, "seed count", MAX_SEEDS)
+    if value < 2:
+        raise argparse.ArgumentTypeError("at least 2 seeds are needed to estimate the noise, got 1")
+    return value
+
+
+def _alpha(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"alpha must be a number, got {text!r}") from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"alpha must lie strictly between 0 and 1, got {value:g}")
+    return value
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("mcengine")
+    except PackageNotFoundError:
+        return "(not installed)"
+
+
+def _blender_style(argv: list[str]) -> list[str]:
+    """Rewrite Blender's ``-b FILE ...`` syntax to ``render FILE ...``.
+
+    ``-b`` takes no value in Blender (the file is a separate argument), so it is
+    simply dropped; ``-a`` (animation) and the frame-range flags are refused
+    because this command renders one frame.
+    """
+    unsupported = {"-a", "--render-anim", "-s", "--frame-start", "-e", "--frame-end",
+                   "-j", "--frame-jump", "-P", "--python", "--python-expr", "-x", "--use-extension"}
+    for arg in argv:
+        if arg in unsupported:
+            raise CliError(f"Blender option {arg} is not supported (renders one frame; see {PROG} render --help)")
+    return ["render"] + [arg for arg in argv if arg not in ("-b", "--background")]
+
+
+@dataclass(frozen=True)
+class Output:
+    """One image to save: ``pattern`` is the absolute path before frame substitution."""
+
+    pattern: Path
+    file_format: str
+
+
+@dataclass(frozen=True)
+class RenderRequest:
+    """A validated ``render`` command line."""
+
+    blendfile: Path
+    engine: str
+    outputs: tuple[Output, ...]
+    samples: int | None
+    resolution: tuple[int, int] | None
+    seed: int | None
+    frame: int | None
+    scene: str | None
+    threads: int | None
+    verbose: bool
+    integrator: str | None = None
+    depth: int | None = None
+    branching: int | None = None
+
+
+def check_blend_file(path: Path) -> None:
+    """Raise CliError unless ``path`` is a readable .blend (plain, zstd or gzip)."""
+    if not path.exists():
+        raise CliError(f"file not found: {path}")
+    if not path.is_file():
+        raise CliError(f"not a file: {path}")
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(len(BLEND_MAGIC))
+            handle.seek(0)
+            if head.startswith(ZSTD_MAGIC):
+                head = _zstd_head(handle, len(BLEND_MAGIC))
+            elif head.startswith(GZIP_MAGIC):
+                with gzip.GzipFile(fileobj=handle) as unzipped:
+                    head = unzipped.read(len(BLEND_MAGIC))
+    except (OSError, EOFError) as exc:
+        raise CliError(f"cannot read {path}: {_os_reason(exc)}") from None
+    if head != BLEND_MAGIC:
+        raise CliError(f"not a .blend file: {path}")
+
+
+def _zstd_head(handle, count: int) -> bytes:
+    """First ``count`` decompressed bytes of a zstd stream (b"" if undecodable)."""
+    try:
+        import zstandard  # a dependency of bpy
+    except ImportError:
+        return BLEND_MAGIC  # cannot look inside; let Blender judge the contents
+    try:
+        return zstandard.ZstdDecompressor().stream_reader(handle).read(count)
+    except zstandard.ZstdError:
+        return b""
+
+
+def _os_reason(exc: OSError) -> str:
+    return exc.strerror or str(exc)
+
+
+def _output_for(raw: str, forced_format: str | None, blend_dir: Path) -> Output:
+    """Resolve ``//`` and the format of one ``-o`` value (frame digits come later)."""
+    text = raw
+    if text.startswith("//"):
+        text = str(blend_dir / text[2:])
+    if text.endswith(("/", os.sep)) or text == "":
+        text += "####"  # Blender names a bare folder's image by its frame number
+    pattern = Path(text).absolute()
+    suffix = pattern.suffix.lower()
+    by_extension = next((fmt for fmt, ext in FORMATS.items() if ext == suffix), None)
+    if suffix in OTHER_IMAGE_EXTENSIONS:
+        raise CliError(f"unsupported output type {suffix!r} in {raw} (use .exr or .png)")
+    if forced_format and by_extension and by_extension != forced_format:
+        raise CliError(f"output {raw} has extension {suffix} but the format is {forced_format}")
+    file_format = forced_format or by_extension or DEFAULT_FORMAT
+    if by_extension is None:
+        pattern = pattern.with_name(pattern.name + FORMATS[file_format])
+    return Output(pattern, file_format)
+
+
+def check_output_folder(path: Path) -> None:
+    """Raise CliError unless an image can be created at ``path`` (tested by writing)."""
+    folder = path.parent
+    if not folder.exists():
+        raise CliError(f"output folder does not exist: {folder}")
+    if not folder.is_dir():
+        raise CliError(f"output folder is not a folder: {folder}")
+    if path.is_dir():
+        raise CliError(f"output path is a folder: {path}")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
+
+
+@dataclass(frozen=True)
+class CompareRequest:
+    """A validated ``compare`` command line: ``blendfile`` or ``suite`` is set."""
+
+    blendfile: Path | None
+    suite: Path | None
+    out: Path
+    samples: int | None
+    resolution: tuple[int, int] | None
+    percentage: int | None
+    seeds: int
+    alpha: float
+    scene: str | None
+    threads: int | None
+    verbose: bool
+
+
+def prepare_output_folder(folder: Path) -> None:
+    """Create ``folder`` (and its parents) if needed; raise CliError unless it is writable."""
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"output path is not a folder: {folder}")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
+
+
+def _compare_request(args) -> CompareRequest:
+    if (args.blendfile is None) == (args.suite is None):
+        raise CliError("give either SCENE.blend or --suite FOLDER "
+                       f"(try '{PROG} compare SCENE.blend' or '{PROG} compare --suite blend_scenes/')")
+    blendfile = suite = None
+    if args.suite is not None:
+        suite = Path(args.suite).absolute()
+        if not suite.is_dir():
+            raise CliError(f"suite folder not found: {suite}" if not suite.exists()
+                           else f"--suite needs a folder, not a file: {suite}")
+        files = sorted(suite.glob("*.blend"))
+        if not files:
+            raise CliError(f"no .blend files in {suite}")
+        for path in files:
+            check_blend_file(path)
+        if args.scene is not None:
+            raise CliError("-S/--scene names one scene of one file; it cannot be used with --suite")
+        default_out = "compare-suite"
+    else:
+        blendfile = Path(args.blendfile).absolute()
+        check_blend_file(blendfile)
+        default_out = f"compare-{blendfile.stem}"
+    out = Path(args.out if args.out is not None else default_out).absolute()
+    prepare_output_folder(out)
+    kind, value = args.resolution if args.resolution is not None else (None, None)
+    if kind == "size" and min(value) < MIN_COMPARE_SIZE:
+        raise CliError(f"resolution {value[0]}x{value[1]} is too small for the comparison's "
+                       f"{MIN_COMPARE_SIZE}x{MIN_COMPARE_SIZE} block grid")
+    return CompareRequest(
+        blendfile=blendfile, suite=suite, out=out, samples=args.samples,
+        resolution=value if kind == "size" else None,
+        percentage=value if kind == "percent" else None, seeds=args.seeds, alpha=args.alpha,
+        scene=args.scene, threads=args.threads, verbose=args.verbose)
+
+
+@dataclass(frozen=True)
+class StudyRequest:
+    """A validated ``study`` command line."""
+
+    blendfile: Path
+    out: Path
+    max_samples: int
+    integrators: tuple
+    with_cycles: bool
+    seeds: int
+    resolution: tuple[int, int] | None
+    target: float
+    reference_samples: int | None
+    depth: int | None
+    branching: int | None
+    scene: str | None
+    threads: int | None
+    verbose: bool
+
+
+def _study_request(args) -> StudyRequest:
+    blendfile = Path(args.blendfile).absolute()
+    check_blend_file(blendfile)
+    _check_integrator_options(args.integrators, args.depth, args.branching)
+    if args.reference_samples is not None and args.reference_samples < max(
+            2 * args.max_samples, REFERENCE_RENDERS):
+        raise CliError(f"--reference-samples {args.reference_samples} is too few to measure "
+                       f"errors against: use at least {max(2 * args.max_samples, REFERENCE_RENDERS)} "
+                       f"(twice --max-samples), ideally 16 times")
+    out = Path(args.out if args.out is not None else f"study-{blendfile.stem}").absolute()
+    prepare_output_folder(out)
+    return StudyRequest(
+        blendfile=blendfile, out=out, max_samples=args.max_samples,
+        integrators=args.integrators, with_cycles=args.with_cycles, seeds=args.seeds,
+        resolution=args.resolution, target=args.target,
+        reference_samples=args.reference_samples, depth=args.depth, branching=args.branching,
+        scene=args.scene, threads=args.threads, verbose=args.verbose)
+
+
+def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest | None:
+    """Validate the command line; None means help/version was printed."""
+    if any(arg in ("-b", "--background") for arg in argv):
+        argv = _blender_style(argv)
+    parser = build_parser()
+    if not argv:
+        raise CliError(f"no command given (try '{PROG} render SCENE.blend' or '{PROG} --help')")
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help / --version
+        if exc.code:
+            raise
+        return None
+    if args.command == "compare":
+        return _compare_request(args)
+    if args.command == "study":
+        return _study_request(args)
+    engine = args.engine or DEFAULT_ENGINE
+    _check_integrator_options((args.integrator,) if args.integrator else (), args.depth,
+                              args.branching, engine)
+    blendfile = Path(args.blendfile).absolute()
+    check_blend_file(blendfile)
+    raw_outputs = args.outputs or [f"{blendfile.stem}{FORMATS[args.format or DEFAULT_FORMAT]}"]
+    outputs = tuple(_output_for(raw, args.format, blendfile.parent) for raw in raw_outputs)
+    for output in outputs:
+        check_output_folder(output.pattern)
+    return RenderRequest(
+        blendfile=blendfile, engine=engine, outputs=outputs,
+        samples=args.samples, resolution=args.resolution, seed=args.seed, frame=args.frame,
+        scene=args.scene, threads=args.threads, verbose=args.verbose,
+        integrator=args.integrator, depth=args.depth, branching=args.branching)
+
+
+def frame_path(pattern: Path, frame: int) -> Path:
+    """Replace the last run of ``#`` in the file name with the zero-padded frame."""
+    runs = list(re.finditer(r"#+", pattern.name))
+    if not runs:
+        return pattern
+    last = runs[-1]
+    name = pattern.name[:last.start()] + str(frame).zfill(len(last[0])) + pattern.name[last.end():]
+    return pattern.with_name(name)

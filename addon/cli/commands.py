@@ -1,0 +1,292 @@
+"""The commands of the command line, once their arguments are valid: render, compare, study.
+
+Each ``run_*`` takes a request from :mod:`.args`, imports ``bpy`` (and
+registers MC Engine when it renders with it), does its work with Blender's
+log captured (:mod:`.console`) and returns the exit status; failures are
+raised as :class:`~.errors.CliError`.  Rendering, comparing and studying
+themselves are the add-on's batch tools (:mod:`..batch`); the files come from
+:mod:`mcengine.evaluation.output`.
+"""
+from __future__ import annotations
+
+import contextlib
+import time
+from pathlib import Path
+
+from ..batch.render import (ENGINES, NoSuchScene, OpenError, ensure_registered, error_message,
+                            open_scene, render_scene)
+from ..batch.settings import apply_overrides, set_image_format
+from .args import CompareRequest, RenderRequest, StudyRequest, frame_path
+from .console import BlenderLog, Progress, engine_traceback, warning_lines
+from .errors import EXIT_DIFFER, EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
+
+__all__ = ["run_render", "run_compare", "run_study", "study_line"]
+
+
+# ---------------------------------------------------------------------------
+# Blender
+# ---------------------------------------------------------------------------
+
+def _import_bpy():
+    try:
+        import bpy
+    except ImportError as exc:
+        raise CliError(f"cannot import bpy (Blender 5.0 as a Python module): {exc}",
+                       EXIT_RENDER_FAILED) from None
+    return bpy
+
+
+def _register_addon() -> None:
+    """Register MC Engine (only done when it is the engine asked for)."""
+    try:
+        ensure_registered()
+    except Exception as exc:  # the add-on's failure must not hide behind a traceback
+        raise CliError(f"the MC Engine add-on failed to register: {type(exc).__name__}: {exc}",
+                       EXIT_RENDER_FAILED) from None
+
+
+class _LoggedRenderer:
+    """``render`` for the comparison and the study: a progress bar per render, the log checked.
+
+    Called while Blender's log is captured (the whole command runs inside
+    ``BlenderLog.capture``); the progress bar goes to the real stderr.  An
+    engine's crash (a traceback in the log) is raised as RuntimeError, which
+    the comparison and the study report as a failed render.
+    """
+
+    def __init__(self, bpy, log: BlenderLog, threads: int | None, bars: bool = True):
+        self.bpy = bpy
+        self.log = log
+        self.threads = threads
+        self.bars = bars           # False: no progress display per render
+        self.label = ""
+        self.warnings: list[str] = []
+
+    def on_render(self, engine: str, index: int, total: int) -> None:
+        self.label = f"[{index + 1}/{total}] {engine}"
+
+    def __call__(self, scene, engine, **settings):
+        apply_overrides(scene, threads=self.threads)
+        progress = Progress(self.log.console, self.label or engine)
+        start = self.log.mark()
+        if self.bars:
+            self.bpy.app.handlers.render_stats.append(progress.on_stats)
+        try:
+            result = render_scene(scene, engine, **settings)
+        finally:
+            if self.bars:
+                self.bpy.app.handlers.render_stats.remove(progress.on_stats)
+                progress.finish()
+        text = self.log.text(since=start)
+        crash = engine_traceback(text)
+        if crash is not None:
+            raise RuntimeError(f"{engine} raised {crash}")
+        for warning in warning_lines(text):
+            if warning not in self.warnings:
+                self.warnings.append(warning)
+        return result
+
+
+# ---------------------------------------------------------------------------
+# render
+# ---------------------------------------------------------------------------
+
+def _open(path: Path, scene_name: str | None):
+    try:
+        return open_scene(path, scene_name)
+    except NoSuchScene as exc:
+        raise CliError(str(exc)) from None
+    except OpenError as exc:
+        raise CliError(str(exc), EXIT_RENDER_FAILED) from None
+
+
+def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderLog) -> None:
+    """Render once, save every output, raise CliError on any failure."""
+    first, *others = zip(request.outputs, paths)
+    set_image_format(scene, first[0].file_format)
+    scene.render.filepath = str(first[1])
+    scene.render.use_file_extension = True
+    progress = Progress(log.console, request.engine)
+    log_start = log.mark()
+    bpy.app.handlers.render_stats.append(progress.on_stats)
+    try:
+        with log.capture():
+            bpy.ops.render.render(write_still=True, scene=scene.name)
+    except RuntimeError as exc:
+        raise CliError(f"render failed: {error_message(exc)}", EXIT_RENDER_FAILED) from None
+    finally:
+        bpy.app.handlers.render_stats.remove(progress.on_stats)
+        progress.finish()
+    crash = engine_traceback(log.text(since=log_start))
+    if crash is not None:
+        _remove_quietly(first[1])
+        raise CliError(f"render failed: {request.engine} raised {crash}", EXIT_RENDER_FAILED)
+    if not first[1].is_file():
+        raise CliError(f"render finished but no image was written to {first[1]}", EXIT_RENDER_FAILED)
+    result = bpy.data.images["Render Result"]
+    for output, path in others:
+        set_image_format(scene, output.file_format)
+        try:
+            with log.capture():
+                result.save_render(filepath=str(path), scene=scene)
+        except RuntimeError as exc:
+            raise CliError(f"cannot save {path}: {error_message(exc)}", EXIT_RENDER_FAILED) from None
+
+
+def _remove_quietly(path: Path) -> None:
+    with contextlib.suppress(OSError):
+        path.unlink()
+
+
+def _ray_accounting() -> str | None:
+    """The last MC Engine render's ray accounting line (None if the engine kept none)."""
+    from ..engine import last_render
+    return last_render.get("accounting")
+
+
+def run_render(request: RenderRequest) -> int:
+    """Load, render and save; returns the exit status."""
+    log = BlenderLog(passthrough=request.verbose)
+    started = time.monotonic()
+    ours = request.engine == ENGINES["mcengine"]
+    with log.capture():
+        bpy = _import_bpy()
+        if ours:
+            _register_addon()  # before loading, as an enabled add-on would be
+        scene = _open(request.blendfile, request.scene)
+        apply_overrides(scene, engine=request.engine, samples=request.samples, seed=request.seed,
+                        resolution=request.resolution, threads=request.threads,
+                        frame=request.frame, integrator=request.integrator,
+                        depth=request.depth, branching=request.branching)
+    frame = scene.frame_current
+    paths = [frame_path(output.pattern, frame) for output in request.outputs]
+    _render(bpy, scene, request, paths, log)
+    for warning in warning_lines(log.text()):
+        log.console.write(f"{PROG}: warning: {warning}\n")
+    render = scene.render
+    scale = render.resolution_percentage / 100
+    log.console.write(
+        f"{PROG}: rendered {scene.name!r} frame {frame} with {request.engine}, "
+        f"{round(render.resolution_x * scale)}x{round(render.resolution_y * scale)}, "
+        f"{scene.cycles.samples} samples, in {time.monotonic() - started:.1f} s\n")
+    if ours:
+        accounting = _ray_accounting()
+        if accounting:
+            log.console.write(f"{PROG}: {accounting}\n")
+    for path in paths:
+        print(path)
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------
+# compare
+# ---------------------------------------------------------------------------
+
+def run_compare(request: CompareRequest) -> int:
+    """Compare one file or a suite; returns the exit status (0 agree, 3 differ)."""
+    log = BlenderLog(passthrough=request.verbose)
+    with log.capture():
+        bpy = _import_bpy()
+        _register_addon()
+    from mcengine.evaluation.output import write_comparison
+
+    from ..batch.comparison import CompareError, CompareOptions, compare_file, run_suite
+    renderer = _LoggedRenderer(bpy, log, request.threads)
+    options = CompareOptions(samples=request.samples, resolution=request.resolution,
+                             percentage=request.percentage, seeds=request.seeds,
+                             alpha=request.alpha)
+    console = log.console
+    if request.suite is not None:
+        def on_scene(path, index, total):
+            console.write(f"{PROG}: comparing {path.name} ({index + 1}/{total})\n")
+
+        def on_done(row):
+            detail = row.error if row.verdict == "error" else (
+                f"relMSE {row.relmse:.3g}, FLIP {row.flip:.3f}, blocks differ {row.blocks_differ}")
+            console.write(f"{PROG}: {row.scene}: {row.verdict} ({detail})\n")
+
+        with log.capture():
+            rows, paths = run_suite(request.suite, options, request.out, render=renderer,
+                                    on_scene=on_scene, on_render=renderer.on_render,
+                                    on_done=on_done)
+        verdicts = {row.verdict for row in rows}
+        console.write(f"{PROG}: {sum(r.verdict == 'agree' for r in rows)}/{len(rows)} scenes agree; "
+                      f"summary in {paths['summary.md']} and {paths['summary.html']}\n")
+        print(paths["summary.json"])
+        if "error" in verdicts:
+            return EXIT_RENDER_FAILED
+        return EXIT_DIFFER if "differ" in verdicts else EXIT_OK
+    try:
+        with log.capture():
+            comparison = compare_file(request.blendfile, options, scene_name=request.scene,
+                                      render=renderer, on_render=renderer.on_render)
+            paths = write_comparison(comparison, request.out)
+    except CompareError as exc:
+        raise CliError(str(exc), EXIT_RENDER_FAILED) from None
+    for warning in renderer.warnings:
+        console.write(f"{PROG}: warning: {warning}\n")
+    console.write(f"{PROG}: {comparison.summary()}\n{PROG}: wrote " + ", ".join(
+        str(paths[name]) for name in ("side_by_side.png", "report.md", "mcengine.exr",
+                                      "cycles.exr")) + "\n")
+    print(paths["report.json"])
+    return EXIT_OK if comparison.verdict == "agree" else EXIT_DIFFER
+
+
+# ---------------------------------------------------------------------------
+# study
+# ---------------------------------------------------------------------------
+
+def run_study(request: StudyRequest) -> int:
+    """Render the study and write its files; returns the exit status."""
+    log = BlenderLog(passthrough=request.verbose)
+    with log.capture():
+        bpy = _import_bpy()
+        _register_addon()
+    from mcengine.evaluation.output import write_study
+    from mcengine.evaluation.study import StudyError, StudyOptions, summarise
+
+    from ..batch.study import StudySettings, study_file
+    console = log.console
+    # One line per render: a study makes a hundred, too many for a bar each.
+    renderer = _LoggedRenderer(bpy, log, None, bars=False)
+
+    def on_render(label, index, total):
+        renderer.label = label
+        console.write(f"{PROG}: [{index + 1}/{total}] {label}\n")
+
+    options = StudyOptions(integrators=request.integrators, with_cycles=request.with_cycles,
+                           max_samples=request.max_samples, seeds=request.seeds,
+                           reference_samples=request.reference_samples,
+                           target_relmse=request.target)
+    settings = StudySettings(resolution=request.resolution, depth=request.depth,
+                             branching=request.branching, threads=request.threads)
+    try:
+        with log.capture():
+            study = study_file(request.blendfile, options, settings, scene_name=request.scene,
+                               render=renderer, on_render=on_render)
+            paths = write_study(study, request.out)
+    except (StudyError, RuntimeError) as exc:
+        raise CliError(str(exc).splitlines()[0], EXIT_RENDER_FAILED) from None
+    for warning in renderer.warnings:
+        console.write(f"{PROG}: warning: {warning}\n")
+    for name, s in summarise(study).items():
+        console.write(f"{PROG}: {study_line(name, s)}\n")
+    console.write(f"{PROG}: wrote {paths['csv']}, {paths['time']}, {paths['markdown']}\n")
+    print(paths["html"])
+    return EXIT_OK
+
+
+def study_line(name: str, s) -> str:
+    """One line per integrator: time to target, slope, plateau."""
+    if s.time_to_target is None:
+        reach = f"does not reach relMSE {s.target:g}"
+    else:
+        how = {"extrapolated": " (extrapolated)", "first rung": " (at 1 sample)"}.get(
+            s.target_how, "")
+        reach = f"relMSE {s.target:g} in {s.time_to_target:.2f} s{how}"
+    parts = [f"{name}: {reach}"]
+    if s.slope is not None:
+        parts.append(f"slope {s.slope:.3f} ± {s.slope_ci:.3f}")
+    if s.plateau:
+        parts.append(f"plateau at relMSE {s.floor:.3g}")
+    return ", ".join(parts)

@@ -19,6 +19,7 @@ import time
 
 import bpy
 import numpy as np
+
 from mcengine.scene import SceneError
 
 from . import export

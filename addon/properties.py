@@ -5,6 +5,7 @@ the engine reads ``scene.cycles`` for those (see ``export.settings``).
 """
 # No "from __future__ import annotations": bpy reads the property annotations as objects.
 import bpy
+
 from mcengine import integrators
 
 __all__ = ["MCEngineSceneSettings", "register", "unregister"]

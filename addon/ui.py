@@ -13,6 +13,7 @@ Everything is undone on unregister.
 from __future__ import annotations
 
 import bpy
+
 from mcengine.integrators import from_enum
 
 from .engine import ENGINE_ID

@@ -39,6 +39,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     import bpy  # noqa: F401  (Blender as a module)
+
     from mcengine_blender import engine
     from mcengine_blender.batch.render import ensure_registered, open_scene, render_scene
     from mcengine_blender.batch.settings import make_unbiased

@@ -33,10 +33,9 @@ import os
 import sys
 from pathlib import Path
 
+import _blendfile
 import bpy
 import zstandard
-
-import _blendfile
 from mathutils import Euler, Vector
 
 # Render settings shared by every scene (see the module docstring).

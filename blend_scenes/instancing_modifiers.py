@@ -26,9 +26,8 @@ Run: .venv/bin/python blend_scenes/instancing_modifiers.py
 """
 import math
 
-import bpy
-
 import _common as c
+import bpy
 
 ARCH_HALF_VERTICES = [(0.0, -0.1, 0.9), (0.0, 0.1, 0.9), (0.5, -0.1, 0.7), (0.5, 0.1, 0.7),
                       (0.6, -0.1, 0.0), (0.6, 0.1, 0.0), (0.4, -0.1, 0.0), (0.4, 0.1, 0.0),

@@ -33,6 +33,7 @@ class IntegratorInfo:
     uses_depth: bool       # reads ``depth`` (ray levels)
     uses_branching: bool   # reads ``branching`` (rays per hit)
     matches_cycles: bool
+    kernel_code: int       # the integer the kernels know it by (``kernels.classic.CODE_*``)
     # What its images leave out, in words: why its error stops falling (study report).
     leaves_out: str = ""
     # The integrator whose images it renders exactly on a scene without mirrors or
@@ -65,24 +66,24 @@ class IntegratorInfo:
 INTEGRATORS = {info.name: info for info in (
     IntegratorInfo("path", "PATH", "Path Tracing",
                    "One secondary ray per bounce, light sampling with multiple importance "
-                   "sampling, Russian roulette; matches Cycles", False, False, True,
+                   "sampling, Russian roulette; matches Cycles", False, False, True, 0,
                    leaves_out="path tracing is unbiased: a plateau means the reference is not "
                               "converged enough or the two differ"),
     IntegratorInfo("raycast", "RAYCAST", "Ray Casting",
                    "Camera rays and direct light from every light; no reflected light: fast "
-                   "and biased", False, False, False,
+                   "and biased", False, False, False, 1,
                    leaves_out="it stops at the first hit, so all light reflected between "
                               "surfaces (indirect light) and everything seen in mirrors or "
                               "through glass is missing"),
     IntegratorInfo("whitted", "WHITTED", "Whitted",
                    "Direct light plus perfect mirror and refraction rays down to Depth ray "
-                   "levels: 2^depth - 1 rays per sample at most", True, False, False,
+                   "levels: 2^depth - 1 rays per sample at most", True, False, False, 2,
                    leaves_out="it follows only perfect mirror and refraction rays, so light "
                               "reflected between diffuse or glossy surfaces is missing",
                    reduces_to="raycast"),
     IntegratorInfo("distribution", "DISTRIBUTION", "Distribution",
                    "Direct light plus Branching rays at every hit down to Depth ray levels: "
-                   "1 + b + ... + b^(depth-1) rays per sample", True, True, False,
+                   "1 + b + ... + b^(depth-1) rays per sample", True, True, False, 3,
                    leaves_out="its ray tree stops at the depth, so light that needs more "
                               "bounces is missing"),
 )}

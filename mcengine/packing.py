@@ -14,18 +14,38 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .features import Features, detect as detect_features
+from .features import Features
+from .features import detect as detect_features
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_PMF, pack_lights
 from .kernels.materials import M_EMISSION, M_EMISSIVE, pack_materials
 from .kernels.sampling import filter_table
-from .kernels.state import (CFG_FILM_TRANSPARENT, CFG_FULL_W, CFG_LAMPS_HIT, CFG_LIGHTS,
-                            CFG_LOCAL_LIGHTS, CFG_MAX_BOUNCE, CFG_MAX_DIFFUSE, CFG_MAX_GLOSSY,
-                            CFG_MAX_TRANSMISSION, CFG_MAX_TRANSPARENT, CFG_MIN_LIGHT_BOUNCES,
-                            CFG_REGION_W, CFG_REGION_X, CFG_REGION_Y, CFG_SEED, CFG_SIZE,
-                            CFG_WORLD, CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT, FCFG_CLAMP_INDIRECT,
-                            FCFG_EMIT_SCALE, FCFG_SIZE, SceneData)
+from .kernels.state import (
+    CFG_FILM_TRANSPARENT,
+    CFG_FULL_W,
+    CFG_LAMPS_HIT,
+    CFG_LIGHTS,
+    CFG_LOCAL_LIGHTS,
+    CFG_MAX_BOUNCE,
+    CFG_MAX_DIFFUSE,
+    CFG_MAX_GLOSSY,
+    CFG_MAX_TRANSMISSION,
+    CFG_MAX_TRANSPARENT,
+    CFG_MIN_LIGHT_BOUNCES,
+    CFG_REGION_W,
+    CFG_REGION_X,
+    CFG_REGION_Y,
+    CFG_SEED,
+    CFG_SIZE,
+    CFG_WORLD,
+    CFG_WORLD_CAMERA,
+    FCFG_CLAMP_DIRECT,
+    FCFG_CLAMP_INDIRECT,
+    FCFG_EMIT_SCALE,
+    FCFG_SIZE,
+    SceneData,
+)
 from .scene import SceneDescription
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)

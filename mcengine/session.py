@@ -20,7 +20,6 @@ same image for any number of threads.
 """
 from __future__ import annotations
 
-import math
 import os
 import threading
 import time
@@ -36,8 +35,16 @@ from .integrators import get as integrator_info
 from .kernels import classic, path
 from .kernels.intersect import Accel
 from .kernels.materials import M_W_GLASS, M_W_MIRROR, M_W_REFRACT
-from .kernels.state import (ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_NONFINITE, ST_SELF_HITS,
-                            ST_SHADOW_RAYS, ST_SIZE, alloc_path_state, alloc_shadow_queue)
+from .kernels.state import (
+    ST_BOUNCE_RAYS,
+    ST_CAMERA_RAYS,
+    ST_NONFINITE,
+    ST_SELF_HITS,
+    ST_SHADOW_RAYS,
+    ST_SIZE,
+    alloc_path_state,
+    alloc_shadow_queue,
+)
 from .packing import pack_scene
 from .scene import SceneDescription, SceneError
 
@@ -292,15 +299,15 @@ class RenderSession:
     # -- internals -----------------------------------------------------------------------
     @property
     def _classic(self) -> bool:
-        return self.integrator.name != "path"
+        return self.integrator.kernel_code != 0
 
     def _classic_setup(self):
         """Chunk size of the classic integrators: their widest ray generation must fit the batch."""
         it = self.scene.integrator
-        if self.integrator.name == "path":
+        if not self._classic:
             self.roots_per_chunk = self.batch_size
             return
-        self.code = classic.CODES[self.integrator.name]
+        self.code = self.integrator.kernel_code
         self.depth = int(it.depth) if self.integrator.uses_depth else 1
         self.branching = int(it.branching)
         m = self.sc.materials

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
 from mcengine.evaluation.comparison import EngineRuns, SuiteRow, build_comparison, suite_row
 from mcengine.evaluation.output import write_comparison, write_suite
 from mcengine.integrators import INTEGRATORS

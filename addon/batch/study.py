@@ -30,7 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mcengine.evaluation.study import CYCLES, Study, StudyError, StudyOptions, run_study
-from mcengine.integrators import INTEGRATORS, get as get_integrator
+from mcengine.integrators import INTEGRATORS
+from mcengine.integrators import get as get_integrator
 
 from .comparison import matched_settings
 from .render import OpenError, ensure_registered, error_message, open_scene, render_scene

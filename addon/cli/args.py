@@ -20,10 +20,11 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from mcengine.evaluation.study import (DEFAULT_MAX_SAMPLES, DEFAULT_SEEDS as STUDY_SEEDS,
-                                       DEFAULT_TARGET_RELMSE, REFERENCE_RENDERS)
-from mcengine.integrators import (BRANCHING_RANGE, DEFAULT as DEFAULT_INTEGRATOR, DEPTH_RANGE,
-                                  INTEGRATORS, NAMES as INTEGRATOR_NAMES)
+from mcengine.evaluation.study import DEFAULT_MAX_SAMPLES, DEFAULT_TARGET_RELMSE, REFERENCE_RENDERS
+from mcengine.evaluation.study import DEFAULT_SEEDS as STUDY_SEEDS
+from mcengine.integrators import BRANCHING_RANGE, DEPTH_RANGE, INTEGRATORS
+from mcengine.integrators import DEFAULT as DEFAULT_INTEGRATOR
+from mcengine.integrators import NAMES as INTEGRATOR_NAMES
 
 from ..batch.render import ENGINES
 from .errors import PROG, CliError

@@ -13,8 +13,15 @@ import contextlib
 import time
 from pathlib import Path
 
-from ..batch.render import (ENGINES, NoSuchScene, OpenError, ensure_registered, error_message,
-                            open_scene, render_scene)
+from ..batch.render import (
+    ENGINES,
+    NoSuchScene,
+    OpenError,
+    ensure_registered,
+    error_message,
+    open_scene,
+    render_scene,
+)
 from ..batch.settings import apply_overrides, set_image_format
 from .args import CompareRequest, RenderRequest, StudyRequest, frame_path
 from .console import BlenderLog, Progress, engine_traceback, warning_lines

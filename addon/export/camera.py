@@ -16,6 +16,7 @@ full frame itself when cropping is off).
 from __future__ import annotations
 
 import numpy as np
+
 from mcengine.scene import Camera, Film
 
 from . import ExportError

@@ -20,6 +20,7 @@ irradiance needs no change.
 from __future__ import annotations
 
 import numpy as np
+
 from mcengine.scene import Light
 
 from .materials import linked_node

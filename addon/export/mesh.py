@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import bpy
 import numpy as np
+
 from mcengine.scene import Geometry
 
 __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances"]

@@ -8,6 +8,7 @@ are used and one warning says so.
 from __future__ import annotations
 
 import numpy as np
+
 from mcengine import integrators
 from mcengine.scene import Integrator
 

@@ -17,8 +17,17 @@ import math
 from ..integrators import INTEGRATORS
 from .comparison import DETECTION_POWER, Comparison, SuiteRow
 from .stats import CHANNELS
-from .study import (CONFIDENCE, CYCLES, DEFAULT_TARGET_RELMSE, MIN_FIT_RUNGS, NOISE_DOMINANCE,
-                    SLOPE_MIN_SAMPLES, Study, Summary, engine_label)
+from .study import (
+    CONFIDENCE,
+    CYCLES,
+    DEFAULT_TARGET_RELMSE,
+    MIN_FIT_RUNGS,
+    NOISE_DOMINANCE,
+    SLOPE_MIN_SAMPLES,
+    Study,
+    Summary,
+    engine_label,
+)
 
 __all__ = ["report_markdown", "suite_markdown", "suite_summary_markdown", "suite_html",
            "target_table_markdown", "study_markdown", "study_html"]
@@ -424,7 +433,8 @@ reference.</p>
 <ul>
 {''.join(refs)}
 <li>Error model: each integrator's mean untrimmed relMSE per sample count (the mean squared
-error, see the slope below) is fitted by a/N + c/N² + b (a, b ≥ 0, relative least squares).  b is what samples cannot remove: the algorithm's squared
+error, see the slope below) is fitted by a/N + c/N² + b (a, b ≥ 0, relative least squares).
+b is what samples cannot remove: the algorithm's squared
 bias plus the reference's own error; c/N² accounts for the first sample of each pixel, taken at
 the pixel centre.  An integrator <i>plateaus</i> when its bias exceeds its noise at the largest
 sample count.</li>

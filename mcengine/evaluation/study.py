@@ -89,8 +89,9 @@ from typing import Callable
 
 import numpy as np
 
-from ..integrators import INTEGRATORS, NAMES, get as get_integrator
 from ..imageio import to_display
+from ..integrators import INTEGRATORS, NAMES
+from ..integrators import get as get_integrator
 from .comparison import CYCLES_LABEL
 from .stats import jsonable, relmse, smape, student_t_isf
 

@@ -27,8 +27,17 @@ import numpy as np
 from ..jit import device, kernel
 from .intersect import T_INFINITE
 from .sampling import DIM_FILTER_X, DIM_FILTER_Y, filter_offset, path_key, rand
-from .state import (CFG_FILM_TRANSPARENT, CFG_FULL_W, CFG_REGION_W, CFG_REGION_X, CFG_REGION_Y,
-                    CFG_SEED, PF_CAMERA, PF_MIS_SKIP, PF_TRANSPARENT_BG)
+from .state import (
+    CFG_FILM_TRANSPARENT,
+    CFG_FULL_W,
+    CFG_REGION_W,
+    CFG_REGION_X,
+    CFG_REGION_Y,
+    CFG_SEED,
+    PF_CAMERA,
+    PF_MIS_SKIP,
+    PF_TRANSPARENT_BG,
+)
 
 CAM_PERSP = 0
 CAM_ORTHO = 1

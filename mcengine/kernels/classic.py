@@ -39,21 +39,54 @@ from .closures.fresnel import fresnel_dielectric
 from .intersect import offset_origin
 from .light_sampling import PMF_EVERY, pick_light
 from .lights import L_PMF
-from .materials import (M_EMISSIVE, M_GLASS, M_IOR, M_MIRROR, M_REFRACT, M_W_GLASS, M_W_MIRROR,
-                        M_W_REFRACT, bsdf_has_lobes)
-from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_LIGHT_PICK, DIM_LIGHT_U,
-                       DIM_LIGHT_V, mix64, rand)
-from .shading import (direct_light, light_from_background, light_from_emitter, light_from_lamps,
-                      next_path_flags, sample_direction, set_ray, to_world)
-from .state import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_MAX_TRANSPARENT, FCFG_EMIT_SCALE,
-                    ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS, ST_SHADOW_RAYS)
+from .materials import (
+    M_EMISSIVE,
+    M_GLASS,
+    M_IOR,
+    M_MIRROR,
+    M_REFRACT,
+    M_W_GLASS,
+    M_W_MIRROR,
+    M_W_REFRACT,
+    bsdf_has_lobes,
+)
+from .sampling import (
+    DIM_BSDF_LOBE,
+    DIM_BSDF_U,
+    DIM_BSDF_V,
+    DIM_LIGHT_PICK,
+    DIM_LIGHT_U,
+    DIM_LIGHT_V,
+    mix64,
+    rand,
+)
+from .shading import (
+    direct_light,
+    light_from_background,
+    light_from_emitter,
+    light_from_lamps,
+    next_path_flags,
+    sample_direction,
+    set_ray,
+    to_world,
+)
+from .state import (
+    CFG_LAMPS_HIT,
+    CFG_LIGHTS,
+    CFG_MAX_TRANSPARENT,
+    FCFG_EMIT_SCALE,
+    ST_BOUNCE_RAYS,
+    ST_CAMERA_RAYS,
+    ST_SELF_HITS,
+    ST_SHADOW_RAYS,
+)
 from .surface import hit_distance, local_frame, past_self_hit, surface_point
 
-# Integer codes of the classic integrators in the kernels (names: mcengine.integrators).
+# Integer codes of the classic integrators in the kernels: ``IntegratorInfo.kernel_code``
+# of mcengine.integrators (a test checks that they agree).
 CODE_RAYCAST = 1
 CODE_WHITTED = 2
 CODE_DISTRIBUTION = 3
-CODES = {"raycast": CODE_RAYCAST, "whitted": CODE_WHITTED, "distribution": CODE_DISTRIBUTION}
 _K_CHILD = np.uint64(0xA24BAED4963EE407)
 _K_LIGHT = np.uint64(0x9FB21C651E98DF25)
 

@@ -24,11 +24,26 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device
-from .lights import (L_FLAGS, L_MAX_BOUNCES, L_PMF, L_SUN_OMC, L_TYPE, LF_CAST_SHADOW, LF_USE_MIS,
-                     LF_VIS_CAMERA, LF_VIS_DIFFUSE, LF_VIS_GLOSSY, LF_VIS_TRANSMISSION, LT_SUN,
-                     intersect_lamp, lamp_importance, sample_lamp, sun_radiance)
-from .materials import M_EMISSION
 from .closures import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
+from .lights import (
+    L_FLAGS,
+    L_MAX_BOUNCES,
+    L_PMF,
+    L_SUN_OMC,
+    L_TYPE,
+    LF_CAST_SHADOW,
+    LF_USE_MIS,
+    LF_VIS_CAMERA,
+    LF_VIS_DIFFUSE,
+    LF_VIS_GLOSSY,
+    LF_VIS_TRANSMISSION,
+    LT_SUN,
+    intersect_lamp,
+    lamp_importance,
+    sample_lamp,
+    sun_radiance,
+)
+from .materials import M_EMISSION
 from .sampling import power_heuristic, uniform_triangle
 from .state import PF_CAMERA, PF_DIFFUSE, PF_GLOSSY, PF_MIS_SKIP, PF_REFLECT, PF_TRANSMIT
 

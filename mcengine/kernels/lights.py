@@ -265,7 +265,8 @@ def spread_window(lamps, li, px, py, pz):
     ``(x0, x1, y0, y1)`` (local coordinates, metres) bounding that circle and
     the light, and its area; area 0 if p cannot be lit.  Without spread, or
     when the circle covers the whole light, the window is the whole light and
-    the area returned is the light's own (an ellipse is then sampled as one).  Sampling only this window is what Cycles does
+    the area returned is the light's own (an ellipse is then sampled as one).
+    Sampling only this window is what Cycles does
     (area.h, area_light_spread_clamp_light); it changes noise, not the mean.
     """
     hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
@@ -303,7 +304,8 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         azx, azy, azz = lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2]
         omc = lamps[li, L_SUN_OMC]
         if omc <= 0.0:
-            return azx, azy, azz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], 0.0
+            return (azx, azy, azz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1],
+                    lamps[li, L_RADIANCE + 2], 0.0)
         x, y, z = uniform_cone(u1, u2, omc)
         tx, ty, tz, bx, by, bz = orthonormal_basis(azx, azy, azz)
         wx = x * tx + y * bx + z * azx

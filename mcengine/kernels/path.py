@@ -34,17 +34,47 @@ from ..jit import device, kernel
 from .camera import generate_camera_rays
 from .closures import LABEL_DIFFUSE, LABEL_REFLECT
 from .intersect import offset_origin
-from .light_sampling import (PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light,
-                             pick_light_local)
+from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
 from .materials import M_EMISSIVE, bsdf_has_lobes
-from .sampling import (DIM_BSDF_LOBE, DIM_BSDF_U, DIM_BSDF_V, DIM_LIGHT_GROUP, DIM_LIGHT_PICK,
-                       DIM_LIGHT_U, DIM_LIGHT_V, DIM_ROULETTE, bounce_dim, rand)
-from .shading import (direct_light, light_from_background, light_from_emitter, light_from_lamps,
-                      next_path_flags, sample_direction, set_ray)
-from .state import (CFG_LAMPS_HIT, CFG_LIGHTS, CFG_LOCAL_LIGHTS, CFG_MAX_BOUNCE, CFG_MAX_DIFFUSE,
-                    CFG_MAX_GLOSSY, CFG_MAX_TRANSMISSION, CFG_MAX_TRANSPARENT,
-                    CFG_MIN_LIGHT_BOUNCES, FCFG_EMIT_SCALE, PF_MIS_SKIP, PF_TERMINATE,
-                    ST_BOUNCE_RAYS, ST_CAMERA_RAYS, ST_SELF_HITS, ST_SHADOW_RAYS)
+from .sampling import (
+    DIM_BSDF_LOBE,
+    DIM_BSDF_U,
+    DIM_BSDF_V,
+    DIM_LIGHT_GROUP,
+    DIM_LIGHT_PICK,
+    DIM_LIGHT_U,
+    DIM_LIGHT_V,
+    DIM_ROULETTE,
+    bounce_dim,
+    rand,
+)
+from .shading import (
+    direct_light,
+    light_from_background,
+    light_from_emitter,
+    light_from_lamps,
+    next_path_flags,
+    sample_direction,
+    set_ray,
+)
+from .state import (
+    CFG_LAMPS_HIT,
+    CFG_LIGHTS,
+    CFG_LOCAL_LIGHTS,
+    CFG_MAX_BOUNCE,
+    CFG_MAX_DIFFUSE,
+    CFG_MAX_GLOSSY,
+    CFG_MAX_TRANSMISSION,
+    CFG_MAX_TRANSPARENT,
+    CFG_MIN_LIGHT_BOUNCES,
+    FCFG_EMIT_SCALE,
+    PF_MIS_SKIP,
+    PF_TERMINATE,
+    ST_BOUNCE_RAYS,
+    ST_CAMERA_RAYS,
+    ST_SELF_HITS,
+    ST_SHADOW_RAYS,
+)
 from .surface import hit_distance, local_frame, past_self_hit, surface_point
 
 

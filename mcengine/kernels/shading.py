@@ -30,17 +30,44 @@ import math
 from collections import namedtuple
 
 from ..jit import device
-from .closures import (LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT,
-                       bsdf_eval, bsdf_sample)
+from .closures import (
+    LABEL_DIFFUSE,
+    LABEL_GLOSSY,
+    LABEL_REFLECT,
+    LABEL_SINGULAR,
+    LABEL_TRANSMIT,
+    bsdf_eval,
+    bsdf_sample,
+)
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
-from .light_sampling import (PMF_EVERY, PMF_LOCAL, emission_weight, group_importance,
-                             lamps_on_segment, sample_light, sun_light)
+from .light_sampling import (
+    PMF_EVERY,
+    PMF_LOCAL,
+    emission_weight,
+    group_importance,
+    lamps_on_segment,
+    sample_light,
+    sun_light,
+)
 from .materials import M_EMISSION
 from .sampling import power_heuristic
-from .state import (CFG_MAX_TRANSPARENT, CFG_WORLD, CFG_WORLD_CAMERA, FCFG_CLAMP_DIRECT,
-                    FCFG_CLAMP_INDIRECT, FCFG_EMIT_SCALE, PF_CAMERA, PF_DIFFUSE, PF_GLOSSY,
-                    PF_MIS_SKIP, PF_REFLECT, PF_TERMINATE, PF_TRANSMIT, PF_TRANSPARENT_BG,
-                    ST_NONFINITE)
+from .state import (
+    CFG_MAX_TRANSPARENT,
+    CFG_WORLD,
+    CFG_WORLD_CAMERA,
+    FCFG_CLAMP_DIRECT,
+    FCFG_CLAMP_INDIRECT,
+    FCFG_EMIT_SCALE,
+    PF_CAMERA,
+    PF_DIFFUSE,
+    PF_GLOSSY,
+    PF_MIS_SKIP,
+    PF_REFLECT,
+    PF_TERMINATE,
+    PF_TRANSMIT,
+    PF_TRANSPARENT_BG,
+    ST_NONFINITE,
+)
 
 DirectionSample = namedtuple("DirectionSample", [
     "ok",                    # False: no direction (absorbed, or through the wrong side)

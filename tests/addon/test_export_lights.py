@@ -4,6 +4,7 @@ import math
 import bpy
 import numpy as np
 import pytest
+
 from .helpers import export_scene
 
 

@@ -1,6 +1,7 @@
 """Material export: Principled / Diffuse / Emission values and one warning per unsupported material."""
 import bpy
 import pytest
+
 from .helpers import export_scene, new_mesh_object
 
 

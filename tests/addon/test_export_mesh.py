@@ -4,6 +4,7 @@ import math
 import bpy
 import numpy as np
 import pytest
+
 from .helpers import CUBE_FACES, CUBE_VERTS, export_scene, new_mesh_object
 
 TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]

@@ -2,6 +2,7 @@
 import addon_utils
 import bpy
 import pytest
+
 from .helpers import export_scene
 
 DENOISE = "Cycles denoising is enabled for this scene: not supported yet; rendering all samples without denoising"

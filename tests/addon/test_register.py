@@ -3,6 +3,7 @@ from types import SimpleNamespace
 
 import bpy
 import pytest
+
 from .helpers import load_addon_from_folder
 
 

@@ -4,8 +4,10 @@ from types import SimpleNamespace
 import bpy
 import numpy as np
 import pytest
-from .helpers import GradientSession, new_mesh_object
+
 from mcengine.scene import SceneError
+
+from .helpers import GradientSession, new_mesh_object
 
 
 def test_render_result_equals_the_session_image(scene, fake_session, render_exr):
@@ -154,7 +156,8 @@ def test_core_failure_while_rendering_reports_one_error(scene, addon, monkeypatc
             raise MemoryError("out of memory in pass 2")
 
     sessions = []
-    monkeypatch.setattr(addon.engine, "session_factory", lambda d, threads: sessions.append(Crashing(d)) or sessions[-1])
+    monkeypatch.setattr(addon.engine, "session_factory",
+                        lambda d, threads: sessions.append(Crashing(d)) or sessions[-1])
     message = _render_error(capfd)
     assert message.splitlines()[0] == \
         "Error: MC Engine: failed while rendering: MemoryError: out of memory in pass 2"

@@ -1,6 +1,7 @@
 """F12 with the real core: a tiny scene whose pixels are known exactly."""
 import bpy
 import numpy as np
+
 from .helpers import new_mesh_object
 
 

@@ -3,8 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mcengine.scene import (Camera, Film, Geometry, Integrator, Light, Material, SceneDescription,
-                            World)
+from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
 
 
 def translation(x, y, z) -> np.ndarray:
@@ -31,7 +30,8 @@ def grid_plane(size: float, n: int = 1, z: float = 0.0, center=(0.0, 0.0)) -> np
     tris = []
     for i in range(n):
         for j in range(n):
-            a = (xs[i], xs[j]); b = (xs[i + 1], xs[j]); c = (xs[i + 1], xs[j + 1]); d = (xs[i], xs[j + 1])
+            a, b = (xs[i], xs[j]), (xs[i + 1], xs[j])
+            c, d = (xs[i + 1], xs[j + 1]), (xs[i], xs[j + 1])
             tris.append([a, b, c])
             tris.append([a, c, d])
     t = np.array(tris, float)

@@ -10,8 +10,8 @@ converged reference must satisfy mean(e^2) <= t^2 over the image.
 import numpy as np
 import pytest
 
-from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
+from mcengine.session import RenderSession
 
 from .scenes import grid_plane, translation
 

@@ -15,9 +15,18 @@ import math
 import numpy as np
 import pytest
 
+from mcengine.scene import (
+    Camera,
+    Film,
+    Geometry,
+    Integrator,
+    Light,
+    Material,
+    SceneDescription,
+    SceneError,
+    World,
+)
 from mcengine.session import RenderSession
-from mcengine.scene import (Camera, Film, Geometry, Integrator, Light, Material, SceneDescription,
-                            SceneError, World)
 
 from .expect import assert_mean, render
 from .scenes import inside_sphere_scene, plane_scene, translation, uv_sphere
@@ -120,3 +129,11 @@ def test_too_wide_a_ray_tree_is_a_clear_error():
     scene.integrator.branching, scene.integrator.depth = 64, 5
     with pytest.raises(SceneError, match="exceed the batch"):
         RenderSession(scene)
+
+
+def test_kernel_codes_agree_with_the_registry():
+    from mcengine.integrators import INTEGRATORS
+    from mcengine.kernels import classic
+    assert {name: info.kernel_code for name, info in INTEGRATORS.items()} == {
+        "path": 0, "raycast": classic.CODE_RAYCAST, "whitted": classic.CODE_WHITTED,
+        "distribution": classic.CODE_DISTRIBUTION}

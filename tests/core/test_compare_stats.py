@@ -21,8 +21,16 @@ import pytest
 from scipy import stats
 
 from mcengine.evaluation.stats import (
-    MAX_CORRELATION_LAG, _lag_correlation, block_edges, block_means, compare_stacks,
-    holm_adjust, relmse, smape, student_t_isf, student_t_sf,
+    MAX_CORRELATION_LAG,
+    _lag_correlation,
+    block_edges,
+    block_means,
+    compare_stacks,
+    holm_adjust,
+    relmse,
+    smape,
+    student_t_isf,
+    student_t_sf,
 )
 
 NULL_TRIALS = 200

@@ -1,7 +1,5 @@
 """Core boundaries: no Blender import, scene files, validation, image files, warps."""
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -69,7 +67,8 @@ def test_disk_sampling_is_uniform_and_the_naive_map_is_not():
     """The lecture's example: r = sqrt(u) is uniform on the disk, r = u crowds the centre."""
     from scipy.stats import chi2
     u = np.random.default_rng(3).random((200_000, 2))
-    crit = lambda dof: chi2.ppf(1 - 1e-4, dof)
+    def crit(dof):
+        return chi2.ppf(1 - 1e-4, dof)
     for warp in (disk_polar, disk_concentric):
         pts = np.array([warp(a, b) for a, b in u])
         stat, dof = _chi2_uniform_disk(pts)

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
+from mcengine.session import RenderSession
 
 from .expect import assert_mean, image_mean_and_se, render
 from .scenes import inside_sphere_scene, translation, uv_sphere

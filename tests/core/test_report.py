@@ -9,8 +9,14 @@ import struct
 import numpy as np
 import pytest
 
-from mcengine.evaluation.comparison import (EngineRuns, SuiteRow, build_comparison,
-                                            detectable_bias, differing_regions, suite_row)
+from mcengine.evaluation.comparison import (
+    EngineRuns,
+    SuiteRow,
+    build_comparison,
+    detectable_bias,
+    differing_regions,
+    suite_row,
+)
 from mcengine.evaluation.output import write_comparison, write_suite
 from mcengine.evaluation.pages import suite_html, suite_markdown
 from mcengine.evaluation.stats import compare_stacks

@@ -17,8 +17,8 @@ from mcengine.evaluation import study as S
 from mcengine.evaluation.datafiles import COLUMNS, read_csv
 from mcengine.evaluation.output import write_study
 from mcengine.evaluation.stats import relmse
-from mcengine.session import RenderSession
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
+from mcengine.session import RenderSession
 
 from .scenes import grid_plane, translation
 from .test_adaptive import _box

@@ -27,8 +27,18 @@ from __future__ import annotations
 import math
 
 from ...jit import device
-from ..materials import (M_BASE, M_GLASS, M_IOR, M_MIRROR, M_REFRACT, M_W_DIFFUSE, M_W_GLASS,
-                         M_W_MIRROR, M_W_REFRACT, M_W_TOTAL)
+from ..materials import (
+    M_BASE,
+    M_GLASS,
+    M_IOR,
+    M_MIRROR,
+    M_REFRACT,
+    M_W_DIFFUSE,
+    M_W_GLASS,
+    M_W_MIRROR,
+    M_W_REFRACT,
+    M_W_TOTAL,
+)
 from ..sampling import cosine_hemisphere
 from .fresnel import fresnel_dielectric
 

@@ -3,9 +3,10 @@
 The render asks this module before it starts, so that no work is done for
 what the scene does not contain: no shadow rays without lights, no lamp
 intersection tests when no lamp can be hit, no background lookups for a black
-world.  The lobes (diffuse, sharp reflection, refraction) are found from the
-materials the triangles use.  ``summary()`` is the line the MC Engine panel
-shows ("Effects: ...").
+world, no hit-by-hit shadow rays unless a material lets light through.  The
+kinds of surface (diffuse, rough or sharp glossy, glass, sheen, ...) are read
+from the shader graphs of the materials the triangles use.  ``summary()`` is
+the line the MC Engine panel shows.
 """
 from __future__ import annotations
 
@@ -13,6 +14,9 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from .kernels.state import MF_TRANSPARENT
+from .scene import Link
 
 
 @dataclass(frozen=True)
@@ -22,9 +26,8 @@ class Features:
     world: bool = False            # the background is not black
     lamps_hit: bool = False        # some lamp can be hit by camera or BSDF rays
     nee: bool = False              # something to sample with next-event estimation
-    diffuse: bool = False          # some surface has a diffuse lobe
-    glossy: bool = False           # ... a mirror or glass lobe
-    transmission: bool = False     # ... a glass or refraction lobe
+    lobes: tuple = ()              # kinds of surface, in LOBE_ORDER
+    transparent_shadows: bool = False   # shadow rays pass some material's transparency
 
     def summary(self) -> str:
         """One line for the UI and the logs."""
@@ -34,11 +37,8 @@ class Features:
             lights.append(f"{n} emissive triangle{'s' if n > 1 else ''}")
         if self.world:
             lights.append("world")
-        lobes = [name for name, on in (("diffuse", self.diffuse),
-                                       ("sharp reflection", self.glossy),
-                                       ("refraction", self.transmission)) if on]
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
-                f"surfaces: {', '.join(lobes) if lobes else 'black'}")
+                f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}")
 
 
 def lamp_can_be_hit(light) -> bool:
@@ -52,19 +52,82 @@ def lamp_can_be_hit(light) -> bool:
     return has_surface and light.use_mis
 
 
-def detect(scene, emissive_triangles: int, lamp_power) -> Features:
-    """Features of ``scene`` given its emissive triangle count and lamp powers."""
+def detect(scene, emissive_triangles: int, lamp_power, material_flags) -> Features:
+    """Features of ``scene`` given its emissive triangle count, lamp powers and the MF_*
+    flags of its materials."""
     lamps = [li for li, pw in zip(scene.lights, lamp_power) if pw > 0.0]
-    used = set(np.unique(scene.geometry.material_index).tolist())
-    mats = [m for i, m in enumerate(scene.materials) if i in used]
-    has = lambda attr: any(max(getattr(m, attr)) > 0.0 for m in mats)  # noqa: E731
+    used = sorted(set(np.unique(scene.geometry.material_index).tolist()))
+    kinds = set()
+    for i in used:
+        kinds |= surface_kinds(scene.materials[i])
     return Features(
-        diffuse=has("base_color"),
-        glossy=has("mirror_color") or has("glass_color"),
-        transmission=has("glass_color") or has("refraction_color"),
+        lobes=tuple(k for k in LOBE_ORDER if k in kinds),
+        transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
         world=bool(np.max(np.asarray(scene.world.color, float)) > 0.0),
         lamps_hit=any(lamp_can_be_hit(li) for li in lamps if li.type != "SUN"),
         nee=bool(lamps) or emissive_triangles > 0,
     )
+
+
+LOBE_ORDER = ("diffuse", "rough diffuse", "sheen", "translucent", "rough glossy", "sharp glossy",
+              "coat", "rough glass", "sharp glass", "rough refraction", "sharp refraction",
+              "transparent", "emission", "holdout")
+# Roughness below which a microfacet lobe is a perfect mirror (alpha_x alpha_y <= 2e-10).
+SHARP_ROUGHNESS = 2e-10 ** 0.25
+
+
+def surface_kinds(material) -> set:
+    """The kinds of surface a material's graph can produce (its inputs are constants)."""
+    nodes, surface = material.graph()
+    if surface is None:
+        return set()
+    kinds, seen, todo = set(), set(), [surface.node]
+    while todo:
+        k = todo.pop()
+        if k in seen:
+            continue
+        seen.add(k)
+        node = nodes[k]
+        inputs = node.inputs
+        for value in inputs.values():
+            if isinstance(value, Link):
+                todo.append(value.node)
+
+        def get(name, default):
+            value = inputs.get(name, default)
+            return default if isinstance(value, Link) else value
+
+        def sharp(name, default):
+            return float(get(name, default)) <= SHARP_ROUGHNESS
+        kind = node.type
+        if kind == "BsdfDiffuse":
+            kinds.add("rough diffuse" if get("Roughness", 0.0) > 0.0 else "diffuse")
+        elif kind == "BsdfGlossy":
+            kinds.add("sharp glossy" if sharp("Roughness", 0.5) else "rough glossy")
+        elif kind == "BsdfGlass":
+            kinds.add("sharp glass" if sharp("Roughness", 0.0) else "rough glass")
+        elif kind == "BsdfRefraction":
+            kinds.add("sharp refraction" if sharp("Roughness", 0.0) else "rough refraction")
+        elif kind in ("BsdfTranslucent", "BsdfTransparent", "BsdfSheen", "Emission", "Holdout"):
+            kinds.add({"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent",
+                       "BsdfSheen": "sheen", "Emission": "emission", "Holdout": "holdout"}[kind])
+        elif kind == "BsdfPrincipled":
+            metallic = float(get("Metallic", 0.0))
+            transmission = float(get("Transmission Weight", 0.0))
+            rough = "sharp" if sharp("Roughness", 0.5) else "rough"
+            if (1 - metallic) * (1 - transmission) > 0 and max(get("Base Color", (0.8,) * 3)) > 0:
+                kinds.add("rough diffuse" if get("Diffuse Roughness", 0.0) > 0.0 else "diffuse")
+            if metallic > 0 or get("Specular IOR Level", 0.5) > 0:
+                kinds.add(f"{rough} glossy")
+            if transmission > 0:
+                kinds.add(f"{rough} glass")
+            for name, default, what in (("Coat Weight", 0.0, "coat"), ("Sheen Weight", 0.0, "sheen")):
+                if get(name, default) > 0:
+                    kinds.add(what)
+            if get("Alpha", 1.0) < 1.0:
+                kinds.add("transparent")
+            if get("Emission Strength", 0.0) > 0 and max(get("Emission Color", (1, 1, 1))) > 0:
+                kinds.add("emission")
+    return kinds

@@ -5,8 +5,9 @@
   keys its cache on the file of each function only (and not on the jit
   options), so a kernel would keep the stale code of a helper it inlined
   from another file; the cache therefore lives in a folder named after a
-  hash of every source that compiled code comes from (this file and the
-  ``kernels`` package: ``__pycache__/numba-<hash>`` next to them, or
+  hash of every source that compiled code comes from (this file, the
+  ``kernels`` package and its data tables, which numba freezes into the
+  code: ``__pycache__/numba-<hash>`` next to them, or
   ``~/.cache/mcengine`` if that is not writable; ``NUMBA_CACHE_DIR`` still
   wins).
 * ``error_model="numpy"``: float division by zero gives inf/NaN instead of
@@ -20,6 +21,10 @@
   every array as a struct and checks an error status), which summed over the
   dozen helpers of a shading step made it several times slower.  Kernels
   compile more slowly; the cache keeps that a one-off.
+* ``function``: the few large steps (running a shader, evaluating or
+  sampling a closure list) are called, not inlined: they cost far more than a
+  call, and inlining them into every caller made compilation take many
+  minutes.
 * ``_nrt=False``: no reference counting of arrays.  With it, numba wraps
   every array it takes out of a tuple or hands to a helper in atomic
   increments and decrements, which measured 28 % of the render time.  The
@@ -40,7 +45,9 @@ def _cache_dir() -> str | None:
         return None
     here = Path(__file__).resolve().parent
     digest = hashlib.sha256()
-    for source in [Path(__file__).resolve(), *sorted((here / "kernels").rglob("*.py"))]:
+    kernels = here / "kernels"
+    sources = sorted([*kernels.rglob("*.py"), *kernels.rglob("*.npy")])
+    for source in [Path(__file__).resolve(), *sources]:
         digest.update(str(source.relative_to(here)).encode())
         digest.update(source.read_bytes())
     base = here / "__pycache__"
@@ -72,4 +79,5 @@ def _cached(decorator):
 
 
 device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=False))
+function = _cached(njit(cache=True, error_model="numpy", _nrt=False))
 kernel = _cached(njit(cache=True, nogil=True, error_model="numpy", _nrt=False))

@@ -2,7 +2,7 @@
 
 The scene model (``scene``) is made for people and files; the kernels want
 contiguous float64/int32 tables with fixed columns (``kernels.state``,
-``kernels.lights``, ``kernels.materials``, ``kernels.camera``), the light
+``kernels.lights``, ``kernels.camera``), the shader programs (``shaders``), the light
 picking distributions, and two small settings vectors (``cfg`` integers,
 ``fcfg`` floats) that also carry the decisions of ``features``.  This module
 builds all of them once per render.
@@ -19,9 +19,10 @@ from .features import detect as detect_features
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_PMF, pack_lights
-from .kernels.materials import M_EMISSION, M_EMISSIVE, pack_materials
 from .kernels.sampling import filter_table
 from .kernels.state import (
+    CFG_CAUSTICS_REFLECTIVE,
+    CFG_CAUSTICS_REFRACTIVE,
     CFG_FILM_TRANSPARENT,
     CFG_FULL_W,
     CFG_LAMPS_HIT,
@@ -38,15 +39,19 @@ from .kernels.state import (
     CFG_REGION_Y,
     CFG_SEED,
     CFG_SIZE,
+    CFG_TRANSPARENT_SHADOWS,
     CFG_WORLD,
     CFG_WORLD_CAMERA,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
+    FCFG_FILTER_GLOSSY,
     FCFG_SIZE,
+    MF_EMISSIVE,
     SceneData,
 )
 from .scene import SceneDescription
+from .shaders import ShaderTable
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
@@ -80,11 +85,14 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
         hi = np.maximum(hi, np.max(lamp_pos, axis=0))
     scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
 
-    materials = pack_materials(scene.materials)
+    shaders = ShaderTable(scene.materials)
     mat_index = np.ascontiguousarray(g.material_index, np.int32)
-    emissive = (materials[mat_index, M_EMISSIVE] > 0.0) & (tri_area > 0.0) if len(tris) else np.zeros(0, bool)
+    if len(tris):
+        emissive = ((shaders.flags[mat_index] & MF_EMISSIVE) != 0) & (tri_area > 0.0)
+    else:
+        emissive = np.zeros(0, bool)
     emit_tri = np.flatnonzero(emissive).astype(np.int32)
-    emit_power = materials[mat_index[emit_tri], M_EMISSION:M_EMISSION + 3].mean(axis=1) * math.pi * tri_area[emit_tri]
+    emit_power = shaders.emission[mat_index[emit_tri]].mean(axis=1) * math.pi * tri_area[emit_tri]
     tri_light = np.full(len(tris), -1, np.int32)
     tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
 
@@ -104,14 +112,15 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
         emit_group[4] = emit_power.sum() / math.pi
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
-    feats = detect_features(scene, len(emit_tri), lamp_power)
+    feats = detect_features(scene, len(emit_tri), lamp_power, shaders.flags)
 
     film = scene.film
     x0, y0, x1, y1 = film.window
     world = np.asarray(scene.world.color, np.float64).reshape(3)
     sc = SceneData(
         verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
-        mat_index=mat_index, materials=materials,
+        mat_index=mat_index, svm_ops=shaders.ops, svm_consts=shaders.consts,
+        mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=lamps,
         light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf,
         emit_group=emit_group, tri_light=tri_light,
@@ -134,7 +143,11 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     cfg[CFG_FULL_W] = film.width
     cfg[CFG_LIGHTS] = 1 if feats.nee else 0
     cfg[CFG_WORLD] = 1 if feats.world else 0
+    cfg[CFG_CAUSTICS_REFLECTIVE] = 1 if it.caustics_reflective else 0
+    cfg[CFG_CAUSTICS_REFRACTIVE] = 1 if it.caustics_refractive else 0
+    cfg[CFG_TRANSPARENT_SHADOWS] = 1 if feats.transparent_shadows else 0
     fcfg = np.zeros(FCFG_SIZE)
+    fcfg[FCFG_FILTER_GLOSSY] = it.filter_glossy
     # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.
     fcfg[FCFG_CLAMP_DIRECT] = 3.0 * it.clamp_direct if it.clamp_direct > 0 else math.inf
     fcfg[FCFG_CLAMP_INDIRECT] = 3.0 * it.clamp_indirect if it.clamp_indirect > 0 else math.inf

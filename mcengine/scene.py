@@ -30,7 +30,7 @@ import numpy as np
 from . import integrators, memory
 
 __all__ = [
-    "SceneError", "Geometry", "Material", "Light", "Camera", "World", "Film",
+    "SceneError", "Geometry", "Link", "ShaderNode", "Material", "Light", "Camera", "World", "Film",
     "Integrator", "SceneDescription",
 ]
 
@@ -118,31 +118,88 @@ class Geometry:
             object_index=np.concatenate(objs), object_names=names)
 
 
+@dataclass(frozen=True)
+class Link:
+    """An input fed by another node: output socket ``socket`` of node number ``node``."""
+
+    node: int
+    socket: str = ""
+
+
+@dataclass
+class ShaderNode:
+    """One node of a material's shader graph, as plain data.
+
+    ``type`` is Blender's node type without its ``ShaderNode`` prefix
+    ("BsdfPrincipled", "MixShader", ...).  ``inputs`` maps an input socket's
+    identifier to a constant (a number, or a tuple for colours and vectors) or
+    to a :class:`Link`; an input that is absent takes the node's default
+    (``mcengine.kernels.svm.nodes``).  ``props`` holds enum and flag
+    properties ("distribution": "MULTI_GGX", ...).
+    """
+
+    type: str
+    inputs: dict = field(default_factory=dict)
+    props: dict = field(default_factory=dict)
+    name: str = ""
+
+
 @dataclass
 class Material:
-    """A surface shader reduced to the closures the renderer knows.
+    """A surface shader: a graph of shader nodes, as in Blender.
 
-    The BSDF is a sum of lobes, each weighted by a colour (all zero: the
-    surface only emits or is black):
+    ``nodes`` lists the graph's nodes and ``surface`` is what the material
+    output's Surface socket receives (None: black, as in Cycles).
+    ``use_transparent_shadow`` lets shadow rays through transparent closures;
+    ``use_bump_map_correction`` tilts glossy normals whose mirror direction
+    would point into the surface (Cycles' material setting of that name).
 
-    * ``base_color``: Lambertian diffuse reflectance;
-    * ``mirror_color``: perfect mirror (Glossy BSDF at roughness 0);
-    * ``glass_color``: smooth dielectric with Fresnel reflection and
-      refraction (Glass BSDF at roughness 0), index ``ior``;
-    * ``refraction_color``: smooth refraction without reflection
-      (Refraction BSDF at roughness 0), index ``ior``.
-
-    ``emission`` is the emitted radiance (colour x strength), emitted on both
-    sides like Cycles' mesh lights.
+    A material without ``nodes`` is described by the shorthand fields, a sum of
+    closures convenient for tests and tools, equivalent to the graph
+    :meth:`graph` builds: a Diffuse BSDF of ``base_color``, a Glossy BSDF (mirror,
+    roughness 0, colour ``mirror_color``), a Glass BSDF (roughness 0,
+    ``glass_color``, ``ior``), a Refraction BSDF (roughness 0,
+    ``refraction_color``, ``ior``) and an Emission of radiance ``emission``
+    (emitted on both sides like Cycles' mesh lights), added together.
     """
 
     name: str = "default"
+    nodes: list = field(default_factory=list)
+    surface: Link | None = None
+    use_transparent_shadow: bool = True
+    use_bump_map_correction: bool = True
     base_color: tuple = (0.8, 0.8, 0.8)
     emission: tuple = (0.0, 0.0, 0.0)
     mirror_color: tuple = (0.0, 0.0, 0.0)
     glass_color: tuple = (0.0, 0.0, 0.0)
     refraction_color: tuple = (0.0, 0.0, 0.0)
     ior: float = 1.5
+
+    def graph(self) -> tuple[list, Link | None]:
+        """(nodes, surface link) of the material, built from the shorthand if it has no nodes."""
+        if self.nodes:
+            return self.nodes, self.surface
+        nodes = []
+        for color, node in ((self.base_color, ShaderNode("BsdfDiffuse")),
+                            (self.mirror_color, ShaderNode("BsdfGlossy", {"Roughness": 0.0},
+                                                           {"distribution": "GGX"})),
+                            (self.glass_color, ShaderNode("BsdfGlass", {"IOR": self.ior},
+                                                          {"distribution": "GGX"})),
+                            (self.refraction_color, ShaderNode("BsdfRefraction",
+                                                               {"IOR": self.ior},
+                                                               {"distribution": "GGX"}))):
+            if max(color) > 0.0:
+                node.inputs["Color"] = tuple(color)
+                nodes.append(node)
+        if max(self.emission) > 0.0:
+            nodes.append(ShaderNode("Emission", {"Color": tuple(self.emission), "Strength": 1.0}))
+        if not nodes:
+            return [], None
+        out = Link(0, "BSDF")
+        for k in range(1, len(nodes)):
+            nodes.append(ShaderNode("AddShader", {"Shader": out, "Shader_001": Link(k, "BSDF")}))
+            out = Link(len(nodes) - 1, "Shader")
+        return nodes, out
 
 
 @dataclass
@@ -250,6 +307,9 @@ class Integrator:
     min_light_bounces: int = 0
     clamp_direct: float = 0.0        # 0 = off
     clamp_indirect: float = 0.0      # 0 = off
+    filter_glossy: float = 0.0       # Cycles' blur_glossy; 0 = off
+    caustics_reflective: bool = True
+    caustics_refractive: bool = True
     time_limit: float = 0.0          # seconds, 0 = none
     use_adaptive_sampling: bool = False
     adaptive_threshold: float = 0.01   # relative noise at which a pixel stops (0: automatic)
@@ -291,12 +351,13 @@ class SceneDescription:
         if not self.materials:
             raise SceneError("the scene needs at least one material")
         for m in self.materials:
-            if not (np.isfinite(m.ior) and m.ior > 0):
-                raise SceneError(f"material '{m.name}': ior must be positive, got {m.ior}")
+            where = f"material '{m.name}'"
+            _check_number(where, "ior", m.ior, lo=1e-6)
             for attr in ("base_color", "emission", "mirror_color", "glass_color", "refraction_color"):
                 v = np.asarray(getattr(m, attr), float)
                 if v.shape != (3,) or not np.all(np.isfinite(v)) or np.any(v < 0):
-                    raise SceneError(f"material '{m.name}': {attr} must be 3 finite non-negative values")
+                    raise SceneError(f"{where}: {attr} must be 3 finite non-negative values")
+            _check_graph(where, m)
         for li in self.lights:
             where = f"light '{li.name}'"
             if li.type not in LIGHT_TYPES:
@@ -346,7 +407,8 @@ class SceneDescription:
         for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
                      "transparent_max_bounces", "min_light_bounces", "adaptive_min_samples"):
             _check_number("integrator", attr, getattr(i, attr), lo=0, hi=MAX_BOUNCES)
-        for attr in ("clamp_direct", "clamp_indirect", "time_limit", "adaptive_threshold"):
+        for attr in ("clamp_direct", "clamp_indirect", "filter_glossy", "time_limit",
+                     "adaptive_threshold"):
             _check_number("integrator", attr, getattr(i, attr), lo=0.0)
         return self
 
@@ -446,8 +508,7 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
         film["region"] = tuple(film["region"])
     return SceneDescription(
         geometry=geom,
-        materials=[Material(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in d.items()})
-                   for d in meta["materials"]],
+        materials=[_material_from_saved(d) for d in meta["materials"]],
         lights=lights, camera=Camera(**cam),
         world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
         film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
@@ -499,3 +560,36 @@ def _check_matrix(where: str, value, axes: bool = False) -> None:
         raise SceneError(f"{where}: matrix_world must be a finite 4x4 matrix")
     if axes and np.any(np.linalg.norm(m[:3, :3], axis=0) <= 0.0):
         raise SceneError(f"{where}: matrix_world has a zero-length axis (scale 0)")
+
+
+def _check_graph(where: str, material: Material) -> None:
+    """Links point at existing nodes and every constant input is finite."""
+    nodes = material.nodes
+    links = [material.surface] if material.surface is not None else []
+    for k, node in enumerate(nodes):
+        if not isinstance(node, ShaderNode) or not isinstance(node.type, str):
+            raise SceneError(f"{where}: node {k} is not a ShaderNode")
+        for socket, value in node.inputs.items():
+            if isinstance(value, Link):
+                links.append(value)
+            elif not np.all(np.isfinite(np.asarray(value, float))):
+                raise SceneError(f"{where}: node {k} ({node.type}) input '{socket}' is not finite")
+    for link in links:
+        if not isinstance(link, Link) or not 0 <= link.node < len(nodes):
+            raise SceneError(f"{where}: a link refers to node {getattr(link, 'node', link)!r}, "
+                             f"which does not exist")
+
+
+def _material_from_saved(d: dict) -> Material:
+    """A material from its saved form (links are dicts, colours lists)."""
+    def value(v):
+        if isinstance(v, dict):
+            return Link(int(v["node"]), str(v["socket"]))
+        return tuple(v) if isinstance(v, list) else v
+    d = dict(d)
+    d["nodes"] = [ShaderNode(type=n["type"], inputs={k: value(v) for k, v in n["inputs"].items()},
+                             props=dict(n.get("props", {})), name=n.get("name", ""))
+                  for n in d.get("nodes", [])]
+    if d.get("surface") is not None:
+        d["surface"] = value(d["surface"])
+    return Material(**{k: (value(v) if k not in ("nodes", "surface") else v) for k, v in d.items()})

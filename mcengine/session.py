@@ -33,8 +33,8 @@ from .adaptive import Adaptive
 from .film import Film
 from .integrators import get as integrator_info
 from .kernels import classic, path
+from .kernels.classic import WHITTED_RAYS
 from .kernels.intersect import Accel
-from .kernels.materials import M_W_GLASS, M_W_MIRROR, M_W_REFRACT
 from .kernels.state import (
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
@@ -43,8 +43,10 @@ from .kernels.state import (
     ST_SHADOW_RAYS,
     ST_SIZE,
     alloc_path_state,
+    alloc_scratch,
     alloc_shadow_queue,
 )
+from .kernels.svm import OP_CLOSURE
 from .packing import pack_scene
 from .scene import SceneDescription, SceneError
 
@@ -150,6 +152,7 @@ class _Buffers:
         self.key = (batch, classic)
         self.state = alloc_path_state(batch)
         self.shadow = alloc_shadow_queue(batch)
+        self.scratch = alloc_scratch()
         if classic:   # a second generation of rays and per-camera-sample sums
             self.next_state = alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
@@ -158,11 +161,12 @@ class _Buffers:
     @staticmethod
     def bytes_for(batch, classic) -> int:
         """Memory of one worker's buffers for ``batch`` paths (without allocating them)."""
-        return batch * _Buffers(1, classic).nbytes
+        one, two = _Buffers(1, classic).nbytes, _Buffers(2, classic).nbytes
+        return (two - one) * batch + (2 * one - two)     # per path, plus the fixed scratch
 
     @property
     def nbytes(self) -> int:
-        arrays = [*self.state, *self.shadow]
+        arrays = [*self.state, *self.shadow, *self.scratch]
         if self.key[1]:
             arrays += [*self.next_state, self.acc, self.root_pixel]
         return sum(a.nbytes for a in arrays)
@@ -310,11 +314,9 @@ class RenderSession:
         self.code = self.integrator.kernel_code
         self.depth = int(it.depth) if self.integrator.uses_depth else 1
         self.branching = int(it.branching)
-        m = self.sc.materials
-        # Whitted spawns one ray per specular lobe and two for glass.
-        whitted_children = int(((m[:, M_W_MIRROR] > 0) + 2 * (m[:, M_W_GLASS] > 0)
-                                + (m[:, M_W_REFRACT] > 0)).max(initial=1))
-        b = self.branching if self.integrator.uses_branching else max(whitted_children, 1)
+        # Whitted spawns a mirror and a refracted ray per smooth closure, and one through
+        # a transparent closure; its tree is binary unless a material has several.
+        b = self.branching if self.integrator.uses_branching else max(2, self._whitted_width())
         widest = b ** (self.depth - 1)
         if widest > self.batch_size:
             raise SceneError(
@@ -333,6 +335,15 @@ class RenderSession:
             raise SceneError(f"not enough memory: this render needs {need.describe()}, "
                              f"{free / memory.GIB:.2f} GiB are available; lower the resolution "
                              f"or render a region")
+
+    def _whitted_width(self) -> int:
+        """Most rays one Whitted hit can spawn: two per smooth microfacet closure node and one
+        per transparent closure, over the scene's materials (closure nodes in the programs)."""
+        ops, widest = self.sc.svm_ops, 1
+        for start, end in self.sc.mat_prog:
+            kinds = ops[start:end, 1][ops[start:end, 0] == OP_CLOSURE]
+            widest = max(widest, sum(WHITTED_RAYS.get(int(k), 0) for k in kinds))
+        return widest
 
     def _stopping(self, should_stop, t_start, time_limit) -> bool:
         if self._stop.is_set():
@@ -371,10 +382,11 @@ class RenderSession:
         b = w.buffers
         if not self._classic:
             path.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
-                             film, w.stats)
+                             b.scratch, film, w.stats)
         else:
             classic.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
-                                        (b.state, b.next_state, b.shadow, b.acc, b.root_pixel),
+                                        (b.state, b.next_state, b.shadow, b.acc, b.root_pixel,
+                                         b.scratch),
                                         film, w.stats, self.code, self.depth, self.branching)
 
     def _trace(self, pixels, spp):

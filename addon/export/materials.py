@@ -1,33 +1,35 @@
-"""Blender materials -> :class:`mcengine.scene.Material` (a sum of closures).
+"""Blender materials -> :class:`mcengine.scene.Material` (a graph of shader nodes).
 
-The shader read is the node linked to the Surface socket of the material's
-active output for Cycles (``node_tree.get_output_node('CYCLES')``, target ALL
-or CYCLES), following reroutes and skipping muted links.
+The graph read is what the Surface socket of the material's active Cycles
+output (``node_tree.get_output_node('CYCLES')``) receives, following
+reroutes, skipping muted links and passing through muted nodes as Blender
+does.  Every shader node the renderer evaluates is copied with all its inputs
+(their unlinked values) and its properties; the core shades them as Cycles
+does (``mcengine.kernels.svm``):
 
-* Principled BSDF: base colour = 'Base Color' (clamped >= 0), emission =
-  'Emission Color' x 'Emission Strength'.  Exact when 'Specular IOR Level',
-  Metallic, Transmission, Coat, Sheen, Subsurface and Diffuse Roughness are 0
-  and Alpha is 1; anything else is named in the material's warning.
-* Diffuse BSDF: 'Color'; Roughness > 0 is Oren-Nayar in Cycles (warned, Lambert used).
-* Emission: radiance 'Color' x 'Strength', no diffuse reflection.
-* Glossy, Glass and Refraction BSDFs: a mirror, a smooth dielectric and a
-  smooth refraction lobe with the node's Color (and IOR); exact at Roughness
-  0, rendered sharp (and warned) otherwise.
-* Mix Shader and Add Shader: the closures of their inputs, weighted by the
-  mix factor or summed, as Cycles sums closures.
-* Nothing linked to Surface, or no output: black, as in Cycles.
-* Any other surface node: 0.8 grey diffuse (Cycles' default surface), warned.
-* A linked input (a texture, a node group, ...) is replaced by the socket's
-  unlinked value, warned.
-* A material without a node tree (files from before Blender 5.0, where
-  ``use_nodes`` could be off) uses ``diffuse_color``, as Cycles does.
+* Principled, Diffuse, Glossy, Glass, Refraction, Translucent, Transparent,
+  Sheen, Emission and Holdout nodes, Mix Shader and Add Shader;
+* Metallic BSDF in F82 mode becomes the Principled BSDF at Metallic 1 (the
+  same closure); in Physical Conductor mode its IOR and extinction are fitted
+  to F82 (warned);
+* Subsurface Scattering becomes a Diffuse BSDF of its colour, and the
+  Principled's subsurface layer is rendered as diffuse (Cycles' own
+  zero-radius limit), warned;
+* any other shader node: 0.8 grey diffuse (Cycles' default surface), warned;
+* a linked input that is not a shader (a texture, a math node, a normal map,
+  ...) is replaced by the socket's unlinked value, warned;
+* nothing linked to Surface, or no output: black, as in Cycles;
+* a material without a node tree uses ``diffuse_color``, as Cycles does.
 
 Each material gets at most one warning line listing everything ignored in it.
 Colours are linear, in the scene's working colour space.
 """
 from __future__ import annotations
 
-from mcengine.scene import Material
+import math
+
+from mcengine.kernels.svm.nodes import INPUTS
+from mcengine.scene import Link, Material, ShaderNode
 
 __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node", "clamp_color", "fmt"]
 
@@ -36,19 +38,19 @@ DEFAULT_GREY = (0.8, 0.8, 0.8)
 DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
 BLACK = (0.0, 0.0, 0.0)
 
-# Principled BSDF inputs that add lobes the Lambert core does not have yet:
-# (socket name, short feature name, value at which the lobe vanishes).
-_PRINCIPLED_LOBES = (
-    ("Specular IOR Level", "specular", 0.0),
-    ("Metallic", "metallic", 0.0),
-    ("Transmission Weight", "transmission", 0.0),
-    ("Coat Weight", "coat", 0.0),
-    ("Sheen Weight", "sheen", 0.0),
-    ("Subsurface Weight", "subsurface", 0.0),
-    ("Diffuse Roughness", "rough diffuse", 0.0),
-    ("Thin Film Thickness", "thin film", 0.0),
-    ("Alpha", "alpha", 1.0),
-)
+# Blender node types -> the graph's node types (the Glossy BSDF is
+# ShaderNodeBsdfAnisotropic since Blender 4.0).
+_NODE_TYPES = {
+    "ShaderNodeBsdfPrincipled": "BsdfPrincipled", "ShaderNodeBsdfDiffuse": "BsdfDiffuse",
+    "ShaderNodeBsdfAnisotropic": "BsdfGlossy", "ShaderNodeBsdfGlossy": "BsdfGlossy",
+    "ShaderNodeBsdfGlass": "BsdfGlass", "ShaderNodeBsdfRefraction": "BsdfRefraction",
+    "ShaderNodeBsdfTranslucent": "BsdfTranslucent", "ShaderNodeBsdfTransparent": "BsdfTransparent",
+    "ShaderNodeBsdfSheen": "BsdfSheen", "ShaderNodeEmission": "Emission",
+    "ShaderNodeHoldout": "Holdout", "ShaderNodeMixShader": "MixShader",
+    "ShaderNodeAddShader": "AddShader",
+}
+_ROUTING_INPUTS = {"MixShader": ("Fac", "Shader", "Shader_001"), "AddShader": ("Shader", "Shader_001")}
+_THIN_FILM_CUTOFF = 0.1
 
 
 class MaterialTable:
@@ -77,209 +79,210 @@ class MaterialTable:
 def convert_material(ctx, material) -> Material:
     """Convert one Blender material; unsupported parts become one warning in ``ctx``."""
     name = material.name
+    settings = dict(use_transparent_shadow=bool(getattr(material, "use_transparent_shadow", True)),
+                    use_bump_map_correction=bool(getattr(getattr(material, "cycles", None),
+                                                         "use_bump_map_correction", True)))
     tree = material.node_tree
     if tree is None:
-        return Material(name=name, base_color=clamp_color(material.diffuse_color[:3]))
+        return Material(name=name, base_color=clamp_color(material.diffuse_color[:3]), **settings)
     out = tree.get_output_node("CYCLES")
     if out is None:
-        return Material(name=name, base_color=BLACK)
-    notes = _Notes()
+        return Material(name=name, base_color=BLACK, **settings)
+    graph = _Graph()
     for socket_name, what in (("Volume", "volume"), ("Displacement", "displacement")):
         src = linked_node(out.inputs[socket_name])
         if src is not None:
-            notes.add(f"{what} ({_label(src)})", what)
-    closures = _Closures()
-    shader = linked_node(out.inputs["Surface"])
-    if shader is not None:
-        _shader(shader, 1.0, closures, notes, depth=0)
-    result = closures.material(name, notes)
-    if notes.items:
-        ctx.warn(f"material '{name}': {', '.join(notes.items)} not supported yet; "
-                 f"{_fallback_text(result, notes)}", *notes.features)
+            graph.note(f"{what} ({_label(src)})", what)
+    surface = graph.shader(out.inputs["Surface"])
+    if surface is None:
+        result = Material(name=name, base_color=BLACK, **settings)
+    else:
+        result = Material(name=name, nodes=graph.nodes, surface=surface, **settings)
+    if graph.items:
+        ctx.warn(f"material '{name}': {', '.join(graph.items)} not supported yet; "
+                 f"{'; '.join(graph.fallbacks) or 'ignored'}", *graph.features)
     return result
 
 
-class _Closures:
-    """The sum of closures a shader tree evaluates to, each scaled by its mix weight."""
-
-    LOBES = ("base_color", "mirror_color", "glass_color", "refraction_color", "emission")
+class _Graph:
+    """The shader graph being copied from one Blender material, and what it ignores."""
 
     def __init__(self):
-        self.colors = {k: [0.0, 0.0, 0.0] for k in self.LOBES}
-        self.ior = None
-
-    def add(self, lobe, weight, color):
-        acc = self.colors[lobe]
-        for c in range(3):
-            acc[c] += weight * max(float(color[c]), 0.0)
-
-    def set_ior(self, ior, notes, node):
-        if self.ior is None:
-            self.ior = float(ior)
-        elif abs(self.ior - float(ior)) > 1e-6:
-            notes.add(f"{_label(node)} IOR {fmt(ior)} (a second IOR in one material; "
-                      f"{fmt(self.ior)} used)", "several IORs")
-
-    def material(self, name, notes) -> Material:
-        kw = {k: tuple(v) for k, v in self.colors.items()}
-        return Material(name=name, ior=self.ior if self.ior is not None else 1.5, **kw)
-
-
-_MAX_SHADER_DEPTH = 32
-# Glossy BSDF is ShaderNodeBsdfAnisotropic since Blender 4.0 (merged nodes).
-_SHARP_LOBES = {"ShaderNodeBsdfAnisotropic": "mirror_color", "ShaderNodeBsdfGlossy": "mirror_color",
-                "ShaderNodeBsdfGlass": "glass_color", "ShaderNodeBsdfRefraction": "refraction_color"}
-
-
-def _shader(node, weight, closures, notes, depth):
-    """Add the closures of shader ``node`` times ``weight`` to ``closures``."""
-    if weight <= 0.0:
-        return
-    kind = node.bl_idname
-    if depth > _MAX_SHADER_DEPTH:
-        notes.add(f"{_label(node)} (shader tree deeper than {_MAX_SHADER_DEPTH})", "shader nodes")
-    elif kind == "ShaderNodeBsdfPrincipled":
-        _principled(node, weight, closures, notes)
-    elif kind == "ShaderNodeBsdfDiffuse":
-        _diffuse(node, weight, closures, notes)
-    elif kind == "ShaderNodeEmission":
-        closures.add("emission", weight, _emission(node, "Color", "Strength", notes))
-        _note_other_links(node, ("Color", "Strength"), notes)
-    elif kind in _SHARP_LOBES:
-        _sharp(node, weight, closures, notes)
-    elif kind == "ShaderNodeMixShader":
-        fac_socket = node.inputs[0]
-        _note_link(node, fac_socket, notes)
-        fac = min(max(float(fac_socket.default_value), 0.0), 1.0)
-        for sock, w in ((node.inputs[1], 1.0 - fac), (node.inputs[2], fac)):
-            src = linked_node(sock)
-            if src is not None:
-                _shader(src, weight * w, closures, notes, depth + 1)
-    elif kind == "ShaderNodeAddShader":
-        for sock in node.inputs:
-            src = linked_node(sock)
-            if src is not None:
-                _shader(src, weight, closures, notes, depth + 1)
-    else:
-        notes.add(f"{_label(node)} surface shader", "shader nodes")
-        notes.grey_fallback = True
-        closures.add("base_color", weight, DEFAULT_GREY)
-
-
-def _principled(node, weight, closures, notes):
-    for socket_name, feature, neutral in _PRINCIPLED_LOBES:
-        sock = node.inputs[socket_name]
-        if linked_node(sock) is None and sock.default_value != neutral:
-            value = fmt(sock.default_value)
-            notes.add(f"Principled BSDF specular layer ({socket_name} {value})"
-                      if feature == "specular" else f"{socket_name} {value}", feature)
-    closures.add("base_color", weight, _color(node, "Base Color", notes))
-    closures.add("emission", weight, _emission(node, "Emission Color", "Emission Strength", notes))
-    _note_other_links(node, ("Base Color", "Emission Color", "Emission Strength"), notes)
-
-
-def _diffuse(node, weight, closures, notes):
-    rough = node.inputs["Roughness"]
-    if linked_node(rough) is None and rough.default_value > 0:
-        notes.add(f"Diffuse BSDF Roughness {fmt(rough.default_value)} (Oren-Nayar)", "rough diffuse")
-    closures.add("base_color", weight, _color(node, "Color", notes))
-    _note_other_links(node, ("Color",), notes)
-
-
-def _sharp(node, weight, closures, notes):
-    """Glossy, Glass and Refraction BSDFs; exact at Roughness 0 (singular lobes)."""
-    lobe = _SHARP_LOBES[node.bl_idname]
-    rough = node.inputs["Roughness"]
-    if linked_node(rough) is not None or rough.default_value > 0:
-        value = "linked" if linked_node(rough) is not None else fmt(rough.default_value)
-        notes.add(f"{_label(node)} Roughness {value}", "rough glossy")
-        notes.sharpened = True
-    closures.add(lobe, weight, _color(node, "Color", notes))
-    read = ["Color", "Roughness"]
-    if "IOR" in node.inputs:
-        ior = node.inputs["IOR"]
-        _note_link(node, ior, notes)
-        closures.set_ior(ior.default_value, notes, node)
-        read.append("IOR")
-    film = node.inputs.get("Thin Film Thickness")
-    if film is not None and linked_node(film) is None and film.default_value > 0:
-        notes.add(f"{_label(node)} Thin Film Thickness {fmt(film.default_value)}", "thin film")
-    _note_other_links(node, tuple(read), notes)
-
-
-def _color(node, socket_name, notes) -> tuple:
-    sock = node.inputs[socket_name]
-    _note_link(node, sock, notes)
-    return clamp_color(sock.default_value[:3])
-
-
-def _emission(node, color_name, strength_name, notes) -> tuple:
-    color = node.inputs[color_name]
-    strength = node.inputs[strength_name]
-    _note_link(node, color, notes)
-    _note_link(node, strength, notes)
-    return clamp_color([c * strength.default_value for c in color.default_value[:3]])
-
-
-def _note_link(node, sock, notes) -> None:
-    src = linked_node(sock)
-    if src is not None:
-        notes.add(f"{_label(src)} into {_label(node)} '{sock.name}'", "textures")
-        notes.unlinked.append(sock.name)
-
-
-def _note_other_links(node, read, notes) -> None:
-    """Linked inputs the conversion does not read (Normal, Roughness, ...) are ignored."""
-    for sock in node.inputs:
-        if sock.enabled and sock.name not in read and linked_node(sock) is not None:
-            notes.add(f"{_label(linked_node(sock))} into {_label(node)} '{sock.name}'", "textures")
-
-
-class _Notes:
-    """Unsupported things found in one material, for its single warning line."""
-
-    def __init__(self):
+        self.nodes: list[ShaderNode] = []
+        self._index: dict = {}
         self.items: list[str] = []
         self.features: list[str] = []
-        self.unlinked: list[str] = []   # read sockets replaced by their unlinked values
-        self.grey_fallback = False      # an unsupported shader became grey diffuse
-        self.sharpened = False          # a rough glossy/glass was rendered sharp
+        self.fallbacks: list[str] = []
 
-    def add(self, item: str, feature: str) -> None:
+    def note(self, item: str, feature: str, fallback: str = "") -> None:
         if item not in self.items:
             self.items.append(item)
         if feature not in self.features:
             self.features.append(feature)
+        if fallback and fallback not in self.fallbacks:
+            self.fallbacks.append(fallback)
+
+    def shader(self, socket) -> Link | None:
+        """The link a shader socket receives (None: nothing, black)."""
+        source = linked_socket(socket)
+        if source is None:
+            return None
+        node = source.node
+        key = node.as_pointer()
+        if key not in self._index:
+            self._index[key] = None     # a cycle through this node finds nothing
+            index = len(self.nodes)
+            self.nodes.append(ShaderNode(type="", name=node.name))
+            self.nodes[index] = self._convert(node)
+            self._index[key] = index
+        index = self._index[key]
+        if index is None:
+            self.note(f"{_label(node)} (a shader cycle)", "shader nodes")
+            return None
+        return Link(index, "Shader" if self.nodes[index].type in _ROUTING_INPUTS else "BSDF")
+
+    # -- one node -------------------------------------------------------------------------------
+    def _convert(self, node) -> ShaderNode:
+        kind = node.bl_idname
+        if kind == "ShaderNodeBsdfMetallic":
+            return self._metallic(node)
+        if kind == "ShaderNodeSubsurfaceScattering":
+            self.note(f"{_label(node)} (subsurface scattering)", "subsurface",
+                      f"{_label(node)} rendered as diffuse of its colour")
+            return ShaderNode("BsdfDiffuse", {"Color": self._value(node, "Color", 3)}, name=node.name)
+        mapped = _NODE_TYPES.get(kind)
+        if mapped is None:
+            self.note(f"{_label(node)} surface shader", "shader nodes",
+                      f"{_label(node)} rendered as 0.8 grey diffuse")
+            return ShaderNode("BsdfDiffuse", {"Color": DEFAULT_GREY}, name=node.name)
+        if mapped in _ROUTING_INPUTS:
+            inputs = {}
+            for ident in _ROUTING_INPUTS[mapped]:
+                sock = node.inputs[ident]
+                if sock.type == "SHADER":
+                    link = self.shader(sock)
+                    if link is not None:
+                        inputs[ident] = link
+                else:
+                    inputs[ident] = self._value(node, ident, 1)
+            return ShaderNode(mapped, inputs, name=node.name)
+        inputs = {}
+        for ident, size, _default in INPUTS[mapped]:
+            if not ident.startswith("prop:"):
+                inputs[ident] = self._value(node, ident, size)
+        props = {}
+        if any(ident == "prop:distribution" for ident, _size, _default in INPUTS[mapped]):
+            props["distribution"] = self._distribution(node)
+        if mapped == "BsdfSheen" and node.distribution == "ASHIKHMIN":
+            self.note(f"{_label(node)} Ashikhmin velvet sheen", "velvet sheen",
+                      "microfibre sheen used")
+        self._check(node, mapped, inputs)
+        return ShaderNode(mapped, inputs, props, name=node.name)
+
+    def _value(self, node, ident, size):
+        """The unlinked value of an input (a linked non-shader input is noted)."""
+        sock = node.inputs[ident]
+        src = linked_node(sock)
+        if src is not None:
+            self.note(f"{_label(src)} into {_label(node)} '{sock.name}'", "textures",
+                      f"unlinked value of {_label(node)} '{sock.name}' used")
+        value = sock.default_value
+        if size == 1:
+            return float(value)
+        values = [float(v) for v in value[:3]]
+        return tuple(values)
+
+    def _distribution(self, node) -> str:
+        dist = node.distribution
+        if dist == "ASHIKHMIN_SHIRLEY":
+            self.note(f"{_label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley",
+                      "GGX used")
+            return "GGX"
+        return dist
+
+    def _check(self, node, kind, inputs) -> None:
+        """Note what the closure model renders differently from Cycles."""
+        label = _label(node)
+        tangent = inputs.get("Tangent")
+        aniso = inputs.get("Anisotropic", inputs.get("Anisotropy", 0.0))
+        if aniso and (tangent is None or not any(tangent)):
+            self.note(f"{label} anisotropy along the default (radial) tangent", "anisotropy",
+                      f"{label} rendered isotropic")
+        if inputs.get("Thin Film Thickness", 0.0) > _THIN_FILM_CUTOFF:
+            self.note(f"{label} thin film", "thin film", "thin-film interference ignored")
+        if kind == "BsdfPrincipled" and inputs["Subsurface Weight"] > 0.0:
+            self.note(f"{label} subsurface weight {fmt(inputs['Subsurface Weight'])}", "subsurface",
+                      "subsurface rendered as diffuse of the base colour (Cycles' zero-radius limit)")
+
+    def _metallic(self, node) -> ShaderNode:
+        """Metallic BSDF as the Principled at Metallic 1: the same F82-tint conductor."""
+        inputs = {"Metallic": 1.0, "Roughness": self._value(node, "Roughness", 1),
+                  "Anisotropic": min(max(self._value(node, "Anisotropy", 1), 0.0), 1.0),
+                  "Anisotropic Rotation": self._value(node, "Rotation", 1),
+                  "Normal": self._value(node, "Normal", 3), "Tangent": self._value(node, "Tangent", 3),
+                  "Thin Film Thickness": self._value(node, "Thin Film Thickness", 1)}
+        if node.fresnel_type == "F82":
+            inputs["Base Color"] = self._value(node, "Base Color", 3)
+            inputs["Specular Tint"] = self._value(node, "Edge Tint", 3)
+        else:
+            n = self._value(node, "IOR", 3)
+            k = self._value(node, "Extinction", 3)
+            f0 = [_conductor_fresnel(1.0, a, b) for a, b in zip(n, k)]
+            f82 = [_conductor_fresnel(1.0 / 7.0, a, b) for a, b in zip(n, k)]
+            schlick = [f + (1.0 - f) * (6.0 / 7.0) ** 5 for f in f0]
+            inputs["Base Color"] = tuple(f0)
+            inputs["Specular Tint"] = tuple(min(a / b, 1.0) if b > 0 else 1.0 for a, b in zip(f82, schlick))
+            self.note(f"{_label(node)} physical conductor Fresnel", "conductor fresnel",
+                      "fitted to the F82-tint model")
+        node_out = ShaderNode("BsdfPrincipled", inputs, {"distribution": self._distribution(node)},
+                              name=node.name)
+        self._check(node, "BsdfPrincipled", {**inputs, "Subsurface Weight": 0.0})
+        return node_out
 
 
-def _fallback_text(m: Material, notes: _Notes) -> str:
-    parts = []
-    if max(m.base_color) > 0:
-        parts.append(f"Lambert diffuse with base colour {fmt(m.base_color)}")
-    for attr, what in (("mirror_color", "a sharp mirror"), ("glass_color", "sharp glass"),
-                       ("refraction_color", "sharp refraction")):
-        if max(getattr(m, attr)) > 0:
-            parts.append(f"{what} of colour {fmt(getattr(m, attr))}")
-    if max(m.emission) > 0:
-        parts.append(f"emission {fmt(m.emission)}")
-    text = "rendered as " + (" and ".join(parts) if parts else "black")
-    if notes.unlinked:
-        names = ", ".join(f"'{n}'" for n in notes.unlinked)
-        text += f" (unlinked value of {names})"
-    return text
+def _conductor_fresnel(cos_i, n, k) -> float:
+    """Unpolarised reflectance of a conductor of complex IOR n + ik (from air)."""
+    c2 = cos_i * cos_i
+    s2 = 1.0 - c2
+    t0 = n * n - k * k - s2
+    a2b2 = math.sqrt(t0 * t0 + 4.0 * n * n * k * k)
+    a = math.sqrt(max(0.5 * (a2b2 + t0), 0.0))
+    t1 = a2b2 + c2
+    t2 = 2.0 * a * cos_i
+    rs = (t1 - t2) / (t1 + t2)
+    t3 = c2 * a2b2 + s2 * s2
+    t4 = t2 * s2
+    rp = rs * (t3 - t4) / (t3 + t4)
+    return 0.5 * (rs + rp)
 
 
-def linked_node(socket):
-    """The node feeding ``socket`` through reroutes and unmuted links, or None."""
-    while socket.is_linked:
+def linked_socket(socket):
+    """The output socket feeding ``socket`` through reroutes, unmuted links and muted
+    nodes (which pass their first matching input through, as in Blender), or None."""
+    for _ in range(256):
+        if not socket.is_linked:
+            return None
         links = [link for link in socket.links if not link.is_muted]
         if not links:
             return None
-        node = links[0].from_node
-        if node.bl_idname != "NodeReroute":
-            return node
-        socket = node.inputs[0]
+        source = links[0].from_socket
+        node = source.node
+        if node.bl_idname == "NodeReroute":
+            socket = node.inputs[0]
+        elif node.mute:
+            through = [lk.from_socket for lk in node.internal_links if lk.to_socket == source]
+            if not through:
+                return None
+            socket = through[0]
+        else:
+            return source
     return None
+
+
+def linked_node(socket):
+    """The node feeding ``socket`` (see :func:`linked_socket`), or None."""
+    source = linked_socket(socket)
+    return source.node if source is not None else None
 
 
 def _label(node) -> str:

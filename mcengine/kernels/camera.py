@@ -28,7 +28,6 @@ from ..jit import device, kernel
 from .intersect import T_INFINITE
 from .sampling import DIM_FILTER_X, DIM_FILTER_Y, filter_offset, path_key, rand
 from .state import (
-    CFG_FILM_TRANSPARENT,
     CFG_FULL_W,
     CFG_REGION_W,
     CFG_REGION_X,
@@ -149,7 +148,6 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     """
     n = 0
     region_x, region_y, region_w = cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W]
-    transparent_bg = PF_TRANSPARENT_BG if cfg[CFG_FILM_TRANSPARENT] else 0
     for pi in range(pixels.shape[0]):
         pix = pixels[pi]
         x = region_x + pix % region_w
@@ -178,8 +176,9 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.glossy[n] = 0
             st.transmission[n] = 0
             st.transparent[n] = 0
-            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | transparent_bg
+            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG
             st.mis_pdf[n] = 0.0
+            st.min_pdf[n] = math.inf
             st.self_prim[n] = -1
             st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz
             st.d32[n, 0], st.d32[n, 1], st.d32[n, 2] = dx, dy, dz

@@ -34,26 +34,31 @@ import numpy as np
 
 from ..jit import device, kernel
 from .camera import generate_camera_rays
-from .closures import LABEL_REFLECT, LABEL_SINGULAR, LABEL_TRANSMIT
-from .closures.fresnel import fresnel_dielectric
+from .closures.layout import (
+    CL_AX,
+    CL_AY,
+    CL_ETA,
+    CL_N,
+    CL_TYPE,
+    CL_W,
+    CT_MICROFACET,
+    CT_MICROFACET_GLASS,
+    CT_MICROFACET_REFRACTION,
+    CT_TRANSPARENT,
+    LABEL_REFLECT,
+    LABEL_SINGULAR,
+    LABEL_TRANSMIT,
+    ROUGHNESS_SQ_THRESHOLD,
+)
+from .closures.microfacet import microfacet_fresnel
 from .intersect import offset_origin
 from .light_sampling import PMF_EVERY, pick_light
 from .lights import L_PMF
-from .materials import (
-    M_EMISSIVE,
-    M_GLASS,
-    M_IOR,
-    M_MIRROR,
-    M_REFRACT,
-    M_W_GLASS,
-    M_W_MIRROR,
-    M_W_REFRACT,
-    bsdf_has_lobes,
-)
 from .sampling import (
     DIM_BSDF_LOBE,
     DIM_BSDF_U,
     DIM_BSDF_V,
+    DIM_BSDF_W,
     DIM_LIGHT_PICK,
     DIM_LIGHT_U,
     DIM_LIGHT_V,
@@ -62,31 +67,37 @@ from .sampling import (
 )
 from .shading import (
     direct_light,
+    leaves_correct_side,
     light_from_background,
     light_from_emitter,
     light_from_lamps,
     next_path_flags,
     sample_direction,
     set_ray,
-    to_world,
+    shade_point,
 )
+from .shadows import trace_shadows
 from .state import (
     CFG_LAMPS_HIT,
     CFG_LIGHTS,
     CFG_MAX_TRANSPARENT,
     FCFG_EMIT_SCALE,
+    PF_TERMINATE,
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
     ST_SELF_HITS,
-    ST_SHADOW_RAYS,
 )
-from .surface import hit_distance, local_frame, past_self_hit, surface_point
+from .surface import hit_distance, past_self_hit, surface_point
+from .svm.nodes import K_GLASS, K_GLOSSY, K_PRINCIPLED, K_REFRACTION, K_TRANSPARENT
 
 # Integer codes of the classic integrators in the kernels: ``IntegratorInfo.kernel_code``
 # of mcengine.integrators (a test checks that they agree).
 CODE_RAYCAST = 1
 CODE_WHITTED = 2
 CODE_DISTRIBUTION = 3
+# Most Whitted rays one closure node can spawn at a hit (session sizes chunks with it):
+# Principled: coat, metallic, specular mirror rays, glass reflection and refraction, alpha.
+WHITTED_RAYS = {K_PRINCIPLED: 6, K_GLOSSY: 1, K_GLASS: 2, K_REFRACTION: 1, K_TRANSPARENT: 1}
 _K_CHILD = np.uint64(0xA24BAED4963EE407)
 _K_LIGHT = np.uint64(0x9FB21C651E98DF25)
 
@@ -134,7 +145,7 @@ def _copy_node(nx, n_next, st, i, advance):
 
 
 @kernel
-def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stats,
+def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scratch, stats,
                   code, depth, branching):
     """Shade nodes [start, end); children go to ``nx`` from ``n_next`` on.
 
@@ -172,21 +183,24 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
                     continue
         if p < 0:
-            if light_from_background(sc, cfg, fcfg, stats, acc, root, st.beta, i, dx, dy, dz,
-                                     flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct):
-                acc[root, 3] = 1.0
+            acc[root, 3] += light_from_background(sc, cfg, fcfg, stats, acc, root, st.beta, i,
+                                                  dx, dy, dz, flags, mis_pdf, PMF_EVERY,
+                                                  mpx, mpy, mpz, 0.0, direct)
             continue
         if sc.tri_area[p] <= 0.0:
             continue
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
-        if sc.materials[m, M_EMISSIVE] > 0.0:
-            light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, m, p, t_hit, sp.cos_o,
-                               flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct)
-        if not bsdf_has_lobes(sc.materials, m):
+        terminate = (flags & PF_TERMINATE) != 0
+        res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
+        if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
+            light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,
+                               flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,
+                               res.er, res.eg, res.eb)
+        if terminate or res.n == 0:
             continue
+        cl, ncl = scratch.cl, res.n
         key = st.key[i]
-        fr = local_frame(sp.nsx, sp.nsy, sp.nsz, dx, dy, dz)
         spawn = bounce + 2 <= depth          # the children's level is bounce + 2
         # Light samples share MIS with the BSDF rays only if BSDF rays follow.
         nee_mis = code == CODE_DISTRIBUTION and spawn
@@ -205,9 +219,11 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
                     idx = n_lamps + j
                     pmf = sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
-                n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i, m,
-                                        sp, fr, idx, pmf, bounce, rand(lkey, DIM_LIGHT_U),
-                                        rand(lkey, DIM_LIGHT_V), nee_mis, float(branching))
+                n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
+                                        cl, ncl, sp, dx, dy, dz, idx, pmf, bounce,
+                                        rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V),
+                                        nee_mis, float(branching),
+                                        cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
         if not spawn:
             continue
 
@@ -216,52 +232,62 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, stat
             k = 1.0 / branching
             for c in range(branching):
                 ckey = mix64(key ^ (np.uint64(c + 1) * _K_CHILD))
-                ds = sample_direction(sc.materials, m, sp, fr, rand(ckey, DIM_BSDF_LOBE),
-                                      rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V))
+                ds = sample_direction(cl, ncl, sp, dx, dy, dz, rand(ckey, DIM_BSDF_LOBE),
+                                      rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V),
+                                      rand(ckey, DIM_BSDF_W))
                 if not ds.ok:
                     continue
                 n_next = _push_child(nx, n_next, st, i, ckey, sp, ds.wix, ds.wiy, ds.wiz,
                                      br * ds.wr * k, bg * ds.wg * k, bb * ds.wb * k,
                                      next_path_flags(flags, ds.label), branching * ds.pdf, p)
         else:
-            # Whitted: every perfect-specular lobe spawns its ray, weighted
-            # deterministically (Fresnel splits glass into both).
-            eta = sc.materials[m, M_IOR]
-            if sp.backfacing:
-                eta = 1.0 / eta
-            f, cos_t = fresnel_dielectric(fr.woz, eta)
-            for lobe in range(4):
-                if lobe == 0:
-                    if sc.materials[m, M_W_MIRROR] <= 0.0:
-                        continue
-                    col, scale, refract = M_MIRROR, 1.0, False
-                elif lobe == 1 or lobe == 2:
-                    if sc.materials[m, M_W_GLASS] <= 0.0:
-                        continue
-                    refract = lobe == 2
-                    col, scale = M_GLASS, (1.0 - f) if refract else f
-                else:
-                    if sc.materials[m, M_W_REFRACT] <= 0.0:
-                        continue
-                    col, scale, refract = M_REFRACT, 1.0 - (1.0 if cos_t <= 0.0 else 0.0), True
-                if scale <= 0.0:
-                    continue
-                if refract:
-                    wlx, wly, wlz = -fr.wox / eta, -fr.woy / eta, -cos_t
-                    label = LABEL_TRANSMIT | LABEL_SINGULAR
-                else:
-                    wlx, wly, wlz = -fr.wox, -fr.woy, fr.woz
-                    label = LABEL_REFLECT | LABEL_SINGULAR
-                ok, wix, wiy, wiz = to_world(sp, fr, wlx, wly, wlz, label)
-                if not ok:
-                    continue
-                ckey = mix64(key ^ (np.uint64(lobe + 1) * _K_CHILD))
-                n_next = _push_child(nx, n_next, st, i, ckey, sp, wix, wiy, wiz,
-                                     br * sc.materials[m, col] * scale,
-                                     bg * sc.materials[m, col + 1] * scale,
-                                     bb * sc.materials[m, col + 2] * scale,
-                                     next_path_flags(flags, label), 0.0, p)
+            n_next = _whitted_children(cl, ncl, sp, dx, dy, dz, nx, n_next, st, i, key,
+                                       br, bg, bb, flags, p)
     return n_shadow, n_next
+
+
+@device
+def _whitted_children(cl, ncl, sp, dx, dy, dz, nx, n_next, st, i, key, br, bg, bb, flags, p):
+    """Whitted: every perfectly smooth closure spawns its mirror ray, and its refracted
+    ray where it transmits, each weighted deterministically by its Fresnel terms;
+    a transparent closure passes the ray on straight."""
+    for k in range(ncl):
+        t = cl[k, CL_TYPE]
+        if t == CT_TRANSPARENT:
+            ckey = mix64(key ^ (np.uint64(3 * k + 1) * _K_CHILD))
+            n_next = _push_child(nx, n_next, st, i, ckey, sp, dx, dy, dz, br * cl[k, CL_W],
+                                 bg * cl[k, CL_W + 1], bb * cl[k, CL_W + 2], flags, 0.0, p)
+            continue
+        if not (t == CT_MICROFACET or t == CT_MICROFACET_GLASS or t == CT_MICROFACET_REFRACTION):
+            continue
+        if cl[k, CL_AX] * cl[k, CL_AY] > ROUGHNESS_SQ_THRESHOLD:
+            continue
+        nx_, ny_, nz_ = cl[k, CL_N], cl[k, CL_N + 1], cl[k, CL_N + 2]
+        cos_i = -(dx * nx_ + dy * ny_ + dz * nz_)
+        if cos_i <= 0.0:
+            continue
+        rr, rg, rb, tr, tg, tb, cos_t = microfacet_fresnel(cl, k, cos_i)
+        eta = cl[k, CL_ETA]
+        for refract in range(2):
+            if refract:
+                wr_, wg_, wb_ = tr, tg, tb
+                inv = 1.0 / eta
+                a = inv * cos_i - cos_t     # refract_angle with cos_t as Cycles signs it (<= 0)
+                wix, wiy, wiz = dx * inv + a * nx_, dy * inv + a * ny_, dz * inv + a * nz_
+                label = LABEL_TRANSMIT | LABEL_SINGULAR
+            else:
+                wr_, wg_, wb_ = rr, rg, rb
+                wix, wiy, wiz = dx + 2.0 * cos_i * nx_, dy + 2.0 * cos_i * ny_, dz + 2.0 * cos_i * nz_
+                label = LABEL_REFLECT | LABEL_SINGULAR
+            if wr_ <= 0.0 and wg_ <= 0.0 and wb_ <= 0.0:
+                continue
+            if not leaves_correct_side(sp, wix, wiy, wiz, label):
+                continue
+            ckey = mix64(key ^ (np.uint64(3 * k + 2 + refract) * _K_CHILD))
+            n_next = _push_child(nx, n_next, st, i, ckey, sp, wix, wiy, wiz,
+                                 br * cl[k, CL_W] * wr_, bg * cl[k, CL_W + 1] * wg_,
+                                 bb * cl[k, CL_W + 2] * wb_, next_path_flags(flags, label), 0.0, p)
+    return n_next
 
 
 @kernel
@@ -305,7 +331,7 @@ def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
     The caller sizes the chunk so that its widest generation fits the states
     and at most ``shadow capacity / lights per hit`` nodes are shaded at once.
     """
-    cur, nxt, sq, acc, root_pixel = buffers
+    cur, nxt, sq, acc, root_pixel, scratch = buffers
     film_sum, film_sq, film_n = film
     n = generate_camera_rays(pixels, spp, film_n, cur, sc, cfg)
     n_roots = n
@@ -325,11 +351,10 @@ def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
         for start in range(0, n, slice_nodes):
             end = min(n, start + slice_nodes)
             n_shadow, n_next = shade_classic(start, end, prim, cur, nxt, n_next, sq, acc, sc, cfg,
-                                             fcfg, stats, code, depth, branching)
+                                             fcfg, scratch, stats, code, depth, branching)
             if n_shadow:
-                occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
-                stats[ST_SHADOW_RAYS] += n_shadow
-                add_unoccluded(n_shadow, occluded, sq, acc)
+                add_unoccluded(n_shadow, trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats),
+                               sq, acc)
         cur, nxt = nxt, cur
         n = n_next
     splat_roots(n_roots, root_pixel, acc, film_sum, film_sq, film_n)

@@ -24,7 +24,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device
-from .closures import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
+from .closures.layout import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
 from .lights import (
     L_FLAGS,
     L_MAX_BOUNCES,
@@ -43,7 +43,6 @@ from .lights import (
     sample_lamp,
     sun_radiance,
 )
-from .materials import M_EMISSION
 from .sampling import power_heuristic, uniform_triangle
 from .state import PF_CAMERA, PF_DIFFUSE, PF_GLOSSY, PF_MIS_SKIP, PF_REFLECT, PF_TRANSMIT
 
@@ -272,7 +271,7 @@ def emission_weight(tri_light, emit_pmf, tri_area, p, t_hit, cos_o_geo, flags, m
 
 
 @device
-def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, materials,
+def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, mat_emission,
                  idx, pmf, hx, hy, hz, bounce, u1, u2):
     """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h.
 
@@ -313,6 +312,6 @@ def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, 
         return _no_light()
     pdf_l = pmf * d2 / (tri_area[tri] * cos_l)
     em = mat_index[tri]
-    return LightSample(wix, wiy, wiz, dist, materials[em, M_EMISSION] / pdf_l,
-                       materials[em, M_EMISSION + 1] / pdf_l, materials[em, M_EMISSION + 2] / pdf_l,
+    return LightSample(wix, wiy, wiz, dist, mat_emission[em, 0] / pdf_l,
+                       mat_emission[em, 1] / pdf_l, mat_emission[em, 2] / pdf_l,
                        pdf_l, True, True, 0, lnx, lny, lnz)

@@ -28,18 +28,26 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..jit import device, kernel
 from .camera import generate_camera_rays
-from .closures import LABEL_DIFFUSE, LABEL_REFLECT
+from .closures.layout import (
+    CL_AX,
+    CL_AY,
+    CL_TYPE,
+    CT_MICROFACET,
+    CT_MICROFACET_GLASS,
+    CT_MICROFACET_REFRACTION,
+    LABEL_DIFFUSE,
+    LABEL_REFLECT,
+    LABEL_TRANSPARENT,
+)
 from .intersect import offset_origin
 from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
-from .materials import M_EMISSIVE, bsdf_has_lobes
 from .sampling import (
     DIM_BSDF_LOBE,
     DIM_BSDF_U,
     DIM_BSDF_V,
+    DIM_BSDF_W,
     DIM_LIGHT_GROUP,
     DIM_LIGHT_PICK,
     DIM_LIGHT_U,
@@ -56,7 +64,9 @@ from .shading import (
     next_path_flags,
     sample_direction,
     set_ray,
+    shade_point,
 )
+from .shadows import trace_shadows
 from .state import (
     CFG_LAMPS_HIT,
     CFG_LIGHTS,
@@ -68,19 +78,21 @@ from .state import (
     CFG_MAX_TRANSPARENT,
     CFG_MIN_LIGHT_BOUNCES,
     FCFG_EMIT_SCALE,
+    FCFG_FILTER_GLOSSY,
     PF_MIS_SKIP,
     PF_TERMINATE,
+    PF_TRANSPARENT,
+    PF_TRANSPARENT_BG,
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
     ST_SELF_HITS,
-    ST_SHADOW_RAYS,
 )
-from .surface import hit_distance, local_frame, past_self_hit, surface_point
+from .surface import hit_distance, past_self_hit, surface_point
 
 
 # -- 3. shading ---------------------------------------------------------------------------------
 @kernel
-def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
+def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
     """Shade the hits of the n live paths; returns the number of queued shadow rays."""
     n_shadow = 0
     n_lamps = sc.lamps.shape[0]
@@ -88,6 +100,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
     local = cfg[CFG_LOCAL_LIGHTS] != 0
     pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
     has_group = sc.emit_tri.shape[0] > 0
+    max_transparent = cfg[CFG_MAX_TRANSPARENT]
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
@@ -117,68 +130,95 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
                                       mpx, mpy, mpz, mis_total, st.transparent[i], direct)
             if passed:
                 st.transparent[i] += passed
-                if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
+                if st.transparent[i] >= max_transparent:
                     continue   # Cycles: the path ends after the lamp's light
         if p < 0:
-            if light_from_background(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz,
-                                     flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct):
-                st.transparency[i] = 1.0
+            st.transparency[i] += light_from_background(
+                sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz, flags, mis_pdf,
+                pmf_mode, mpx, mpy, mpz, mis_total, direct)
             continue
         if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
+        terminate = (flags & PF_TERMINATE) != 0
+        res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
+
+        # Holdout: the film's alpha drops by the holdout weight on camera paths.
+        if res.holdout > 0.0 and (flags & PF_TRANSPARENT_BG):
+            st.transparency[i] += res.holdout * (st.beta[i, 0] + st.beta[i, 1] + st.beta[i, 2]) / 3.0
+            if res.holdout >= 1.0:
+                continue
+        # Emission (two-sided); the distance for its MIS weight is from the vertex the
+        # ray left (transparent surfaces may lie between).
+        if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
+            hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
+            light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
+                               math.sqrt(hx * hx + hy * hy + hz * hz), sp.cos_o, flags, mis_pdf,
+                               pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
+        if terminate or res.n == 0:
+            continue
+        ncl = res.n
+        if fcfg[FCFG_FILTER_GLOSSY] > 0.0:
+            blur_closures(scratch.cl, ncl, fcfg[FCFG_FILTER_GLOSSY] * st.min_pdf[i])
 
         # Russian roulette (Cycles: from the third vertex on, with the
         # throughput as it is; emission here is not affected by it).
-        q = 1.0
-        if st.bounce[i] > cfg[CFG_MIN_LIGHT_BOUNCES] + 1 and not (flags & PF_TERMINATE):
-            q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
-        if sc.materials[m, M_EMISSIVE] > 0.0:
-            light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, m, p, t_hit, sp.cos_o,
-                               flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct)
-        if (flags & PF_TERMINATE) or not bsdf_has_lobes(sc.materials, m):
-            continue
         bounce = st.bounce[i]
+        vertex = bounce + st.transparent[i]      # random-number dimensions of this vertex
         key = st.key[i]
-        if q < 1.0:
-            if rand(key, bounce_dim(bounce, DIM_ROULETTE)) >= q:
-                continue
-            st.beta[i, 0] /= q
-            st.beta[i, 1] /= q
-            st.beta[i, 2] /= q
-        fr = local_frame(sp.nsx, sp.nsy, sp.nsz, dx, dy, dz)
+        if bounce > cfg[CFG_MIN_LIGHT_BOUNCES] + 1:
+            q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
+            if q < 1.0:
+                if rand(key, bounce_dim(vertex, DIM_ROULETTE)) >= q:
+                    continue
+                st.beta[i, 0] /= q
+                st.beta[i, 1] /= q
+                st.beta[i, 2] /= q
 
         # -- next-event estimation: one light --------------------------------------------------
         if cfg[CFG_LIGHTS]:
-            u_pick = rand(key, bounce_dim(bounce, DIM_LIGHT_PICK))
+            u_pick = rand(key, bounce_dim(vertex, DIM_LIGHT_PICK))
             if local:
                 idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, sp.hx, sp.hy, sp.hz,
                                             u_pick)
                 if idx == n_lamps:
-                    j = pick_light(sc.emit_cdf, rand(key, bounce_dim(bounce, DIM_LIGHT_GROUP)))
+                    j = pick_light(sc.emit_cdf, rand(key, bounce_dim(vertex, DIM_LIGHT_GROUP)))
                     idx = n_lamps + j
                     pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
-            n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i, m,
-                                    sp, fr, idx, pmf, bounce,
-                                    rand(key, bounce_dim(bounce, DIM_LIGHT_U)),
-                                    rand(key, bounce_dim(bounce, DIM_LIGHT_V)), True, 1.0)
+            n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
+                                    scratch.cl, ncl, sp, dx, dy, dz, idx, pmf, bounce,
+                                    rand(key, bounce_dim(vertex, DIM_LIGHT_U)),
+                                    rand(key, bounce_dim(vertex, DIM_LIGHT_V)), True, 1.0,
+                                    max_transparent - st.transparent[i])
 
         # -- BSDF sampling: the next ray ---------------------------------------------------------
-        ds = sample_direction(sc.materials, m, sp, fr, rand(key, bounce_dim(bounce, DIM_BSDF_LOBE)),
-                              rand(key, bounce_dim(bounce, DIM_BSDF_U)),
-                              rand(key, bounce_dim(bounce, DIM_BSDF_V)))
+        ds = sample_direction(scratch.cl, ncl, sp, dx, dy, dz,
+                              rand(key, bounce_dim(vertex, DIM_BSDF_LOBE)),
+                              rand(key, bounce_dim(vertex, DIM_BSDF_U)),
+                              rand(key, bounce_dim(vertex, DIM_BSDF_V)),
+                              rand(key, bounce_dim(vertex, DIM_BSDF_W)))
         if not ds.ok:
             continue
         st.beta[i, 0] *= ds.wr
         st.beta[i, 1] *= ds.wg
         st.beta[i, 2] *= ds.wb
-        st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label), ds.label)
-        st.mis_pdf[i] = ds.pdf
-        st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
+        if ds.label & LABEL_TRANSPARENT:
+            # Straight through: a transparent bounce, the path keeps its flags and MIS data.
+            st.transparent[i] += 1
+            flags |= PF_TRANSPARENT
+            if st.transparent[i] >= max_transparent:
+                flags |= PF_TERMINATE
+            st.flags[i] = flags
+        else:
+            st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label), ds.label)
+            st.mis_pdf[i] = ds.pdf
+            st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
+            if ds.pdf > 0.0:
+                st.min_pdf[i] = min(st.min_pdf[i], ds.pdf)
         nox, noy, noz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz,
                                       ds.wix, ds.wiy, ds.wiz)
         set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
@@ -186,6 +226,20 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, stats):
         st.self_prim[i] = p
         st.alive[i] = 1
     return n_shadow
+
+
+@device
+def blur_closures(cl, ncl, blur_pdf):
+    """Cycles' Filter Glossy: after unlikely bounces (smallest pdf on the path x
+    blur_glossy below 1), microfacet alphas grow to at least sqrt(1 - p) / 2."""
+    if blur_pdf >= 1.0:
+        return
+    r = math.sqrt(1.0 - blur_pdf) * 0.5
+    for k in range(ncl):
+        t = cl[k, CL_TYPE]
+        if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+            cl[k, CL_AX] = max(cl[k, CL_AX], r)
+            cl[k, CL_AY] = max(cl[k, CL_AY], r)
 
 
 @device
@@ -214,7 +268,6 @@ def count_bounce(st, i, cfg, flags, label):
     return flags
 
 
-# -- 5. after the shadow rays ------------------------------------------------------------------
 @kernel
 def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
     """Add unoccluded light, write finished paths to the film, compact the rest.
@@ -222,7 +275,7 @@ def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
     Returns the number of live paths, now at the front of the state arrays.
     """
     for s in range(n_shadow):
-        if not occluded[s]:
+        if not occluded[s] and sq.alive[s]:
             i = sq.path[s]
             st.radiance[i, 0] += sq.contrib[s, 0]
             st.radiance[i, 1] += sq.contrib[s, 1]
@@ -284,7 +337,7 @@ def splat_all(n, st, film_sum, film_sq, film_n):
         _splat(st, i, film_sum, film_sq, film_n)
 
 
-def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, film, stats):
+def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats):
     """Trace spp samples for each pixel in ``pixels`` to completion.
 
     ``film`` is ``(film_sum, film_sq, film_n)``.  A chunk always runs to the
@@ -304,11 +357,7 @@ def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, film, stats):
             stats[ST_BOUNCE_RAYS] += n
         first = False
         prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n])
-        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, stats)
-        if n_shadow:
-            occluded = accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
-            stats[ST_SHADOW_RAYS] += n_shadow
-        else:
-            occluded = np.zeros(0, np.bool_)
+        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats)
+        occluded = trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats)
         n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n)
     splat_all(n, st, film_sum, film_sq, film_n)

@@ -37,6 +37,7 @@ DIM_BSDF_U = 4           # direction from the lobe
 DIM_BSDF_V = 5
 DIM_ROULETTE = 6         # Russian roulette
 DIM_LIGHT_GROUP = 7      # which emissive triangle, once the group is picked
+DIM_BSDF_W = 8           # third number of a BSDF sample (reflection or refraction)
 
 _K_PIXEL = np.uint64(0x9E3779B97F4A7C15)    # golden-ratio increment (Weyl sequence)
 _K_SAMPLE = np.uint64(0xD1B54A32D192ED03)

@@ -7,10 +7,12 @@ order a hit is shaded:
 
 1. ``light_from_lamps``       lamps the ray passed through (they do not block rays);
 2. ``light_from_background``  an escaped ray: the world and suns with an angle;
-3. ``light_from_emitter``     the emission of the surface hit (two-sided);
-4. ``direct_light``           next-event estimation for one chosen light: a light
-                              sample, the BSDF, MIS, clamping, a queued shadow ray;
-5. ``sample_direction``       the BSDF picks the next direction, checked against
+3. ``shade_point``            the material's shader at the hit: its closures,
+                              emission, transparency and holdout (``kernels.svm``);
+4. ``light_from_emitter``     the emission of the surface hit (two-sided);
+5. ``direct_light``           next-event estimation for one chosen light: a light
+                              sample, the closures, MIS, clamping, a queued shadow ray;
+6. ``sample_direction``       the closures pick the next direction, checked against
                               the geometric side it must leave to.
 
 Light is added with ``add_light`` to row ``row`` of an (N, >=3) array ``out``
@@ -34,7 +36,6 @@ from .closures import (
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
     LABEL_REFLECT,
-    LABEL_SINGULAR,
     LABEL_TRANSMIT,
     bsdf_eval,
     bsdf_sample,
@@ -49,15 +50,18 @@ from .light_sampling import (
     sample_light,
     sun_light,
 )
-from .materials import M_EMISSION
 from .sampling import power_heuristic
 from .state import (
+    CFG_CAUSTICS_REFLECTIVE,
+    CFG_CAUSTICS_REFRACTIVE,
+    CFG_FILM_TRANSPARENT,
     CFG_MAX_TRANSPARENT,
     CFG_WORLD,
     CFG_WORLD_CAMERA,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
+    MF_BUMP_CORRECTION,
     PF_CAMERA,
     PF_DIFFUSE,
     PF_GLOSSY,
@@ -65,9 +69,11 @@ from .state import (
     PF_REFLECT,
     PF_TERMINATE,
     PF_TRANSMIT,
+    PF_TRANSPARENT,
     PF_TRANSPARENT_BG,
     ST_NONFINITE,
 )
+from .svm import ShadingData, eval_shader
 
 DirectionSample = namedtuple("DirectionSample", [
     "ok",                    # False: no direction (absorbed, or through the wrong side)
@@ -115,18 +121,21 @@ def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tm
 
 
 @device
-def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb):
+def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb,
+                transparent_left):
     """Queue a shadow ray from the shading point ``sp`` towards the light point.
 
     Returns the new queue length.  Both ends leave their surfaces (pbrt's
     SpawnRayTo): the direction is re-aimed from the offset origin at the offset
     target, else at grazing angles the shifted ray meets the emitter's plane
-    before its end.  ``owner`` is the row the light goes to if unoccluded.
+    before its end.  ``owner`` is the row the light goes to if unoccluded;
+    ``transparent_left`` is how many transparent surfaces the ray may pass.
     """
     hx, hy, hz = sp.hx, sp.hy, sp.hz
     sox, soy, soz = offset_origin(hx, hy, hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
     sdx, sdy, sdz = wix, wiy, wiz
     tmax = T_INFINITE
+    ex = ey = ez = math.inf
     if not math.isinf(dist):
         ex, ey, ez = hx + dist * wix, hy + dist * wiy, hz + dist * wiz
         if lnx != 0.0 or lny != 0.0 or lnz != 0.0:
@@ -142,13 +151,16 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
     sq.t32[n_shadow] = tmax
     sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
     sq.path[n_shadow] = owner
+    sq.target[n_shadow, 0], sq.target[n_shadow, 1], sq.target[n_shadow, 2] = ex, ey, ez
+    sq.transparent[n_shadow] = transparent_left
+    sq.alive[n_shadow] = 1
     return n_shadow + 1
 
 
 @device
 def next_path_flags(flags, label):
     """Path flags after a BSDF sample with ``label`` (Cycles' path_state_next)."""
-    new = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_DIFFUSE |
+    new = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_TRANSPARENT | PF_DIFFUSE |
                     PF_GLOSSY | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
     new |= PF_REFLECT if label & LABEL_REFLECT else PF_TRANSMIT
     if label & LABEL_DIFFUSE:
@@ -182,10 +194,11 @@ def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, f
                           pmf_mode, mpx, mpy, mpz, mis_total, direct):
     """Add the world's and the suns' light to an escaped ray.
 
-    Returns True where the film is transparent (a camera ray on a transparent
-    film sees no background: alpha 0 there).
+    Returns the film transparency it leaves: on a transparent film a camera
+    ray (also through transparent surfaces) sees no background, and the
+    pixel's alpha drops by its average throughput.
     """
-    transparent_film = (flags & PF_TRANSPARENT_BG) != 0
+    transparent_film = cfg[CFG_FILM_TRANSPARENT] != 0 and (flags & PF_TRANSPARENT_BG) != 0
     if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
         add_light(out, row, beta[i, 0] * sc.world[0], beta[i, 1] * sc.world[1],
                   beta[i, 2] * sc.world[2], direct, fcfg, stats)
@@ -195,7 +208,9 @@ def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, f
         if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
                       stats)
-    return transparent_film
+    if transparent_film:
+        return (beta[i, 0] + beta[i, 1] + beta[i, 2]) / 3.0
+    return 0.0
 
 
 @device
@@ -210,22 +225,39 @@ def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
 
 
 @device
-def light_from_emitter(sc, fcfg, stats, out, row, beta, i, m, p, t_hit, cos_o, flags, mis_pdf,
-                       pmf_mode, mpx, mpy, mpz, mis_total, direct):
-    """Add the emission of triangle p (material m, emissive) seen by the ray, MIS-weighted."""
+def shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, allocate):
+    """Run material m's shader at ``sp`` for a ray of direction d and path ``flags``.
+
+    The closures go to ``scratch.cl``; returns the ``ShaderResult``.  With
+    ``allocate`` false only emission, transparency and holdout are computed.
+    """
+    from_diffuse = (flags & PF_DIFFUSE) != 0
+    sd = ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
+                     -dx, -dy, -dz, sp.backfacing, allocate,
+                     cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
+                     cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
+                     (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0)
+    return eval_shader(sc.svm_ops, sc.svm_consts, sc.mat_prog[m, 0], sc.mat_prog[m, 1],
+                       scratch.regs, scratch.cl, sd)
+
+
+@device
+def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, cos_o, flags, mis_pdf,
+                       pmf_mode, mpx, mpy, mpz, mis_total, direct, er, eg, eb):
+    """Add emission (er, eg, eb) of triangle p seen by the ray, MIS-weighted."""
     scale = emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total)
     w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o, flags,
                         mis_pdf, scale)
-    add_light(out, row, beta[i, 0] * sc.materials[m, M_EMISSION] * w,
-              beta[i, 1] * sc.materials[m, M_EMISSION + 1] * w,
-              beta[i, 2] * sc.materials[m, M_EMISSION + 2] * w, direct, fcfg, stats)
+    add_light(out, row, beta[i, 0] * er * w, beta[i, 1] * eg * w, beta[i, 2] * eb * w, direct,
+              fcfg, stats)
 
 
-# -- 4. next-event estimation -----------------------------------------------------------------
+# -- 5. next-event estimation -----------------------------------------------------------------
 @device
-def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, idx, pmf, bounce,
-                 u1, u2, mis_on, bsdf_pdf_scale):
-    """Light from light ``idx`` (picked with probability ``pmf``) reflected at ``sp``.
+def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, cl, ncl, sp, dx, dy, dz, idx,
+                 pmf, bounce, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
+    """Light from light ``idx`` (picked with probability ``pmf``) scattered at ``sp`` by
+    the ``ncl`` closures in ``cl`` towards the viewer (-d).
 
     The light is added to ``out[row]`` at once if the light casts no shadow,
     else queued behind a shadow ray owned by ``row``; returns the queue length.
@@ -235,15 +267,10 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, id
     if pmf <= 0.0:
         return n_shadow
     ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
-                      sc.mat_index, sc.materials, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
-    wix, wiy, wiz = ls.wix, ls.wiy, ls.wiz
-    no_light = ls.lr == 0.0 and ls.lg == 0.0 and ls.lb == 0.0   # (lights may be negative)
-    if no_light or wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz <= 0.0:
+                      sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
+    if ls.lr == 0.0 and ls.lg == 0.0 and ls.lb == 0.0:   # (lights may be negative)
         return n_shadow
-    fr_, fg_, fb_, bsdf_pdf = bsdf_eval(
-        sc.materials, m, fr.wox, fr.woy, fr.woz, wix * fr.tx + wiy * fr.ty + wiz * fr.tz,
-        wix * fr.bx + wiy * fr.by + wiz * fr.bz, wix * sp.nsx + wiy * sp.nsy + wiz * sp.nsz,
-        ls.exclude)
+    fr_, fg_, fb_, bsdf_pdf = bsdf_eval(cl, ncl, -dx, -dy, -dz, ls.wix, ls.wiy, ls.wiz, ls.exclude)
     w = power_heuristic(ls.pdf, bsdf_pdf_scale * bsdf_pdf) if (mis_on and ls.use_mis) else 1.0
     cr = beta[i, 0] * fr_ * ls.lr * w
     cg = beta[i, 1] * fg_ * ls.lg * w
@@ -253,36 +280,29 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, m, sp, fr, id
     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
     if ls.cast_shadow:
-        return push_shadow(sq, n_shadow, row, sp, wix, wiy, wiz, ls.dist, ls.lnx, ls.lny, ls.lnz,
-                           cr, cg, cb)
+        return push_shadow(sq, n_shadow, row, sp, ls.wix, ls.wiy, ls.wiz, ls.dist,
+                           ls.lnx, ls.lny, ls.lnz, cr, cg, cb, transparent_left)
     out[row, 0] += cr
     out[row, 1] += cg
     out[row, 2] += cb
     return n_shadow
 
 
-# -- 5. the next direction -----------------------------------------------------------------------
+# -- 6. the next direction -----------------------------------------------------------------------
 @device
-def to_world(sp, fr, wlx, wly, wlz, label):
-    """(ok, wix, wiy, wiz): a local direction in world space, and whether it
-    leaves to the side of the geometric surface its lobe says (reflection to
-    the viewer's side, transmission to the other); a shading normal can
-    otherwise send a ray through the wrong side."""
-    wix = wlx * fr.tx + wly * fr.bx + wlz * sp.nsx
-    wiy = wlx * fr.ty + wly * fr.by + wlz * sp.nsy
-    wiz = wlx * fr.tz + wly * fr.bz + wlz * sp.nsz
+def leaves_correct_side(sp, wix, wiy, wiz, label):
+    """Whether a sampled direction leaves to the side of the geometric surface its lobe
+    says (reflection to the viewer's side, transmission to the other); a shading
+    normal can otherwise send a ray through the wrong side."""
     cos_i_geo = wix * sp.ngx + wiy * sp.ngy + wiz * sp.ngz
-    ok = not ((label & LABEL_REFLECT and cos_i_geo <= 0.0)
-              or (label & LABEL_TRANSMIT and cos_i_geo >= 0.0))
-    return ok, wix, wiy, wiz
+    return not ((label & LABEL_REFLECT and cos_i_geo <= 0.0)
+                or (label & LABEL_TRANSMIT and cos_i_geo >= 0.0))
 
 
 @device
-def sample_direction(mats, m, sp, fr, u_lobe, u1, u2):
-    """The BSDF of material m samples the next direction at ``sp``."""
-    wlx, wly, wlz, wr, wg, wb, pdf, label = bsdf_sample(
-        mats, m, fr.wox, fr.woy, fr.woz, sp.backfacing, u_lobe, u1, u2)
-    if (pdf <= 0.0 and not (label & LABEL_SINGULAR)) or wr + wg + wb <= 0.0:
+def sample_direction(cl, ncl, sp, dx, dy, dz, u_pick, u1, u2, u3):
+    """The closures sample the next direction at ``sp`` for a ray of direction d."""
+    wix, wiy, wiz, wr, wg, wb, pdf, label = bsdf_sample(cl, ncl, -dx, -dy, -dz, u_pick, u1, u2, u3)
+    if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not leaves_correct_side(sp, wix, wiy, wiz, label):
         return DirectionSample(False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, label)
-    ok, wix, wiy, wiz = to_world(sp, fr, wlx, wly, wlz, label)
-    return DirectionSample(ok, wix, wiy, wiz, wr, wg, wb, pdf, label)
+    return DirectionSample(True, wix, wiy, wiz, wr, wg, wb, pdf, label)

@@ -12,6 +12,9 @@ from collections import namedtuple
 
 import numpy as np
 
+from .closures.layout import CL_STRIDE, MAX_CLOSURES
+from .svm import MAX_REGS
+
 # -- path state ----------------------------------------------------------------------
 PathState = namedtuple("PathState", [
     "key",           # (B,) uint64   RNG key of the path sample
@@ -30,6 +33,7 @@ PathState = namedtuple("PathState", [
     "transparent",   # (B,) int32    transparent passes (lamps count as one)
     "flags",         # (B,) int32    PF_* bits
     "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
+    "min_pdf",       # (B,) f64      smallest BSDF pdf on the path so far (Filter Glossy)
     "mis_p",         # (B, 3) f64    the vertex that ray left (light picking there, for MIS)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
     "alive",         # (B,) uint8    still tracing after this bounce
@@ -42,6 +46,14 @@ ShadowQueue = namedtuple("ShadowQueue", [
     "o32", "d32", "t32",   # Embree input
     "contrib",             # (B, 3) f64  radiance to add if unoccluded
     "path",                # (B,) int32  path the contribution belongs to
+    "target",              # (B, 3) f64  end point of the ray (transparent shadows re-aim at it)
+    "transparent",         # (B,) int32  transparent bounces the path may still make
+    "alive",               # (B,) uint8  still being traced (transparent shadows)
+])
+
+Scratch = namedtuple("Scratch", [
+    "cl",                  # (MAX_CLOSURES, CL_STRIDE) f64  the closures of the point being shaded
+    "regs",                # (MAX_REGS,) f64                the shader evaluator's registers
 ])
 
 SceneData = namedtuple("SceneData", [
@@ -49,7 +61,11 @@ SceneData = namedtuple("SceneData", [
     "tris",          # (T, 3) int32
     "normals",       # (T, 3, 3) f32  shading normals at the corners
     "mat_index",     # (T,) int32
-    "materials",     # (M, MATERIAL_STRIDE) f64
+    "svm_ops",       # (P, 4) int32  every material's shader program (kernels.svm)
+    "svm_consts",    # (C,) f64      their constants
+    "mat_prog",      # (M, 2) int32  [start, end) of material m's program in svm_ops
+    "mat_emission",  # (M, 3) f64    emitted radiance of material m as a light (no layering)
+    "mat_flags",     # (M,) int32    MF_* bits
     "lamps",         # (NL, LIGHT_STRIDE) f64
     "light_cdf",     # (NL + NE + 1,) f64  NEE light distribution
     "emit_tri",      # (NE,) int32  emissive triangle ids
@@ -64,15 +80,21 @@ SceneData = namedtuple("SceneData", [
     "filter_table",  # (FILTER_TABLE_SIZE,) f64
 ])
 
+# Material flags (mat_flags).
+MF_EMISSIVE = 1           # emits light: its triangles are lights for next-event estimation
+MF_TRANSPARENT = 2        # has transparent closures and lets shadow rays through them
+MF_BUMP_CORRECTION = 4    # Cycles' use_bump_map_correction
+
 # Path flags.
 PF_CAMERA = 1            # no scattering yet: the ray is a camera ray
 PF_MIS_SKIP = 2          # emission found by this ray gets MIS weight 1
 PF_TERMINATE = 4         # a bounce limit was reached: the next hit only collects emission
-PF_TRANSPARENT_BG = 8    # camera ray on a transparent film: the background gives alpha 0
+PF_TRANSPARENT_BG = 8    # camera ray, also through transparent surfaces (holdout, transparent film)
 PF_DIFFUSE = 16          # label of the BSDF sample that made the ray
 PF_GLOSSY = 32
 PF_TRANSMIT = 64
 PF_REFLECT = 128
+PF_TRANSPARENT = 256      # the path passed a transparent closure (Cycles' PATH_RAY_TRANSPARENT)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -92,12 +114,16 @@ CFG_FULL_W = 13
 CFG_LIGHTS = 14           # NEE has something to sample
 CFG_WORLD = 15            # the world is not black
 CFG_LOCAL_LIGHTS = 16     # pick lights by their estimated irradiance at each point
-CFG_SIZE = 17
+CFG_CAUSTICS_REFLECTIVE = 17   # glossy reflection after a diffuse bounce (Cycles' switches)
+CFG_CAUSTICS_REFRACTIVE = 18
+CFG_TRANSPARENT_SHADOWS = 19   # some material lets shadow rays through: trace them hit by hit
+CFG_SIZE = 20
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1
 FCFG_EMIT_SCALE = 2       # 1 / (share of the emissive triangles in the scene-wide pmf)
-FCFG_SIZE = 3
+FCFG_FILTER_GLOSSY = 3    # Cycles' blur_glossy; 0: off
+FCFG_SIZE = 4
 
 # Statistics counters (stats array, per worker).
 ST_CAMERA_RAYS = 0
@@ -117,7 +143,7 @@ def alloc_path_state(n: int) -> PathState:
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
-        mis_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
+        mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
         alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
@@ -126,5 +152,11 @@ def alloc_path_state(n: int) -> PathState:
 def alloc_shadow_queue(n: int) -> ShadowQueue:
     return ShadowQueue(o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
                        t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
-                       path=np.zeros(n, np.int32))
+                       path=np.zeros(n, np.int32), target=np.zeros((n, 3)),
+                       transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8))
+
+
+def alloc_scratch() -> Scratch:
+    """A worker's per-hit scratch space (closures and shader registers)."""
+    return Scratch(cl=np.zeros((MAX_CLOSURES, CL_STRIDE)), regs=np.zeros(MAX_REGS))
 

@@ -1,6 +1,9 @@
-"""Material export: Principled / Diffuse / Emission values and one warning per unsupported material."""
+"""Material export: shader graphs copied node by node, and one warning per unsupported material."""
 import bpy
 import pytest
+
+from mcengine.kernels.svm.nodes import INPUTS
+from mcengine.scene import Link
 
 from .helpers import export_scene, new_mesh_object
 
@@ -11,6 +14,11 @@ def exported(sessions, mat):
     desc = export_scene(sessions)
     (m,) = [m for m in desc.materials if m.name == mat.name]
     return m, [w for w in desc.warnings if w.startswith(f"material '{mat.name}'")]
+
+
+def surface(m):
+    """The node the material output receives."""
+    return m.nodes[m.surface.node]
 
 
 def principled(name, **inputs):
@@ -30,50 +38,46 @@ def replace_surface(mat, bl_idname):
     return node
 
 
-def test_principled_without_specular_is_exact(scene, fake_session):
-    mat = principled("Matte", Base_Color=(0.2, 0.4, 0.6, 1), Specular_IOR_Level=0.0,
+def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
+    mat = principled("Plastic", Base_Color=(0.2, 0.4, 0.6, 1), Roughness=0.3, Metallic=0.25,
+                     Coat_Weight=0.5, Coat_Tint=(1, 0.5, 0.5, 1), Sheen_Weight=0.2,
                      Emission_Color=(1, 0.5, 0.25, 1), Emission_Strength=4.0)
+    mat.node_tree.nodes["Principled BSDF"].distribution = "GGX"
     m, warnings = exported(fake_session, mat)
-    assert m.base_color == pytest.approx((0.2, 0.4, 0.6))
-    assert m.emission == pytest.approx((4, 2, 1))
+    node = surface(m)
+    assert node.type == "BsdfPrincipled" and node.props == {"distribution": "GGX"}
+    assert set(node.inputs) == {name for name, _s, _d in INPUTS["BsdfPrincipled"]
+                                if not name.startswith("prop:")}
+    assert node.inputs["Base Color"] == pytest.approx((0.2, 0.4, 0.6))
+    assert (node.inputs["Roughness"], node.inputs["Metallic"], node.inputs["Coat Weight"]) == \
+        pytest.approx((0.3, 0.25, 0.5))
+    assert node.inputs["Coat Tint"] == pytest.approx((1, 0.5, 0.5))
+    assert node.inputs["Emission Strength"] == 4.0
     assert warnings == []
-
-
-def test_principled_lobes_are_named_in_one_warning(scene, fake_session):
-    mat = principled("Wall", Metallic=1.0)
-    m, warnings = exported(fake_session, mat)
-    assert warnings == ["material 'Wall': Principled BSDF specular layer (Specular IOR Level 0.5), "
-                        "Metallic 1 not supported yet; rendered as Lambert diffuse with base colour "
-                        "(0.8, 0.8, 0.8)"]
-    assert m.base_color == pytest.approx((0.8, 0.8, 0.8))
-    assert scene.mcengine.last_ignored.split(", ")[:2] == ["specular", "metallic"]
 
 
 def test_texture_into_base_color_gives_exactly_one_warning(scene, fake_session):
-    mat = principled("Wood", Base_Color=(0.5, 0.25, 0.1, 1), Specular_IOR_Level=0.0)
+    mat = principled("Wood", Base_Color=(0.5, 0.25, 0.1, 1))
     noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
-    mat.node_tree.links.new(noise.outputs["Color"], mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    mat.node_tree.links.new(noise.outputs["Color"],
+                            mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
     m, warnings = exported(fake_session, mat)
-    assert m.base_color == pytest.approx((0.5, 0.25, 0.1))
-    assert warnings == ["material 'Wood': Noise Texture into Principled BSDF 'Base Color' not supported "
-                        "yet; rendered as Lambert diffuse with base colour (0.5, 0.25, 0.1) "
-                        "(unlinked value of 'Base Color')"]
+    assert surface(m).inputs["Base Color"] == pytest.approx((0.5, 0.25, 0.1))
+    assert warnings == ["material 'Wood': Noise Texture into Principled BSDF 'Base Color' not "
+                        "supported yet; unlinked value of Principled BSDF 'Base Color' used"]
+    assert "textures" in scene.mcengine.last_ignored
 
 
-def test_diffuse_bsdf(scene, fake_session):
+def test_diffuse_bsdf_with_roughness(scene, fake_session):
     mat = bpy.data.materials.new("Clay")
     node = replace_surface(mat, "ShaderNodeBsdfDiffuse")
     node.inputs["Color"].default_value = (0.3, 0.2, 0.1, 1)
+    node.inputs["Roughness"].default_value = 0.5
     m, warnings = exported(fake_session, mat)
-    assert (m.base_color, m.emission) == (pytest.approx((0.3, 0.2, 0.1)), (0, 0, 0))
+    assert surface(m).type == "BsdfDiffuse"
+    assert surface(m).inputs["Color"] == pytest.approx((0.3, 0.2, 0.1))
+    assert surface(m).inputs["Roughness"] == 0.5
     assert warnings == []
-
-
-def test_rough_diffuse_is_warned_as_oren_nayar(scene, fake_session):
-    mat = bpy.data.materials.new("Chalk")
-    replace_surface(mat, "ShaderNodeBsdfDiffuse").inputs["Roughness"].default_value = 0.5
-    _, warnings = exported(fake_session, mat)
-    assert len(warnings) == 1 and "Diffuse BSDF Roughness 0.5 (Oren-Nayar)" in warnings[0]
 
 
 def test_emission_shader(scene, fake_session):
@@ -82,56 +86,80 @@ def test_emission_shader(scene, fake_session):
     node.inputs["Color"].default_value = (1, 0.5, 0.25, 1)
     node.inputs["Strength"].default_value = 5.0
     m, warnings = exported(fake_session, mat)
-    assert (m.base_color, m.emission) == ((0, 0, 0), pytest.approx((5, 2.5, 1.25)))
+    assert surface(m).type == "Emission"
+    assert (surface(m).inputs["Color"], surface(m).inputs["Strength"]) == \
+        (pytest.approx((1, 0.5, 0.25)), 5.0)
     assert warnings == []
 
 
-def test_other_shaders_fall_back_to_grey_diffuse(scene, fake_session):
-    mat = bpy.data.materials.new("Velvet")
-    replace_surface(mat, "ShaderNodeBsdfSheen")
-    m, warnings = exported(fake_session, mat)
-    assert m.base_color == (0.8, 0.8, 0.8)
-    assert warnings == ["material 'Velvet': Sheen BSDF surface shader not supported yet; rendered as "
-                        "Lambert diffuse with base colour (0.8, 0.8, 0.8)"]
-
-
-@pytest.mark.parametrize("bl_idname,attr", [("ShaderNodeBsdfAnisotropic", "mirror_color"),
-                                            ("ShaderNodeBsdfGlass", "glass_color"),
-                                            ("ShaderNodeBsdfRefraction", "refraction_color")])
-def test_sharp_glossy_glass_and_refraction(scene, fake_session, bl_idname, attr):
-    mat = bpy.data.materials.new("Sharp")
+@pytest.mark.parametrize("bl_idname,kind", [("ShaderNodeBsdfAnisotropic", "BsdfGlossy"),
+                                            ("ShaderNodeBsdfGlass", "BsdfGlass"),
+                                            ("ShaderNodeBsdfRefraction", "BsdfRefraction"),
+                                            ("ShaderNodeBsdfTranslucent", "BsdfTranslucent"),
+                                            ("ShaderNodeBsdfTransparent", "BsdfTransparent"),
+                                            ("ShaderNodeBsdfSheen", "BsdfSheen"),
+                                            ("ShaderNodeHoldout", "Holdout")])
+def test_every_bsdf_node_is_copied(scene, fake_session, bl_idname, kind):
+    mat = bpy.data.materials.new("Node")
     node = replace_surface(mat, bl_idname)
-    node.inputs["Color"].default_value = (0.9, 0.5, 0.25, 1.0)
-    node.inputs["Roughness"].default_value = 0.0
+    if "Color" in node.inputs:
+        node.inputs["Color"].default_value = (0.9, 0.5, 0.25, 1.0)
+    if "Roughness" in node.inputs:
+        node.inputs["Roughness"].default_value = 0.2
     if "IOR" in node.inputs:
         node.inputs["IOR"].default_value = 1.33
     m, warnings = exported(fake_session, mat)
-    assert getattr(m, attr) == pytest.approx((0.9, 0.5, 0.25))
-    assert m.base_color == (0.0, 0.0, 0.0)
-    assert m.ior == pytest.approx(1.33 if attr != "mirror_color" else 1.5)
+    out = surface(m)
+    assert out.type == kind
+    if "Color" in out.inputs:
+        assert out.inputs["Color"] == pytest.approx((0.9, 0.5, 0.25))
+    if "IOR" in out.inputs:
+        assert out.inputs["IOR"] == pytest.approx(1.33)
+    if hasattr(node, "distribution") and kind != "BsdfSheen":
+        assert out.props == {"distribution": node.distribution}
     assert warnings == []
 
 
-def test_rough_glass_is_rendered_sharp_with_a_warning(scene, fake_session):
-    mat = bpy.data.materials.new("Frosted")
-    node = replace_surface(mat, "ShaderNodeBsdfGlass")
-    node.inputs["Roughness"].default_value = 0.3
+def test_unsupported_shaders_fall_back_to_grey_diffuse(scene, fake_session):
+    mat = bpy.data.materials.new("Cartoon")
+    replace_surface(mat, "ShaderNodeBsdfToon")
     m, warnings = exported(fake_session, mat)
-    assert m.glass_color == (1.0, 1.0, 1.0)
-    assert warnings == ["material 'Frosted': Glass BSDF Roughness 0.3 not supported yet; rendered as "
-                        "sharp glass of colour (1, 1, 1)"]
+    assert surface(m).type == "BsdfDiffuse" and surface(m).inputs["Color"] == (0.8, 0.8, 0.8)
+    assert warnings == ["material 'Cartoon': Toon BSDF surface shader not supported yet; "
+                        "Toon BSDF rendered as 0.8 grey diffuse"]
 
 
-def test_mix_and_add_shaders_sum_weighted_closures(scene, fake_session):
+def test_metallic_node_is_the_principled_conductor(scene, fake_session):
+    mat = bpy.data.materials.new("Gold")
+    node = replace_surface(mat, "ShaderNodeBsdfMetallic")
+    node.inputs["Base Color"].default_value = (1.0, 0.8, 0.3, 1)
+    node.inputs["Edge Tint"].default_value = (1.0, 0.9, 0.7, 1)
+    node.inputs["Roughness"].default_value = 0.35
+    m, warnings = exported(fake_session, mat)
+    out = surface(m)
+    assert out.type == "BsdfPrincipled" and out.inputs["Metallic"] == 1.0
+    assert out.inputs["Base Color"] == pytest.approx((1.0, 0.8, 0.3))
+    assert out.inputs["Specular Tint"] == pytest.approx((1.0, 0.9, 0.7))
+    assert out.inputs["Roughness"] == pytest.approx(0.35)
+    assert warnings == []
+
+
+def test_what_is_rendered_differently_is_warned_once(scene, fake_session):
+    mat = principled("Skin", Subsurface_Weight=0.5, Anisotropic=0.5, Thin_Film_Thickness=300.0)
+    _, warnings = exported(fake_session, mat)
+    assert len(warnings) == 1
+    for part in ("anisotropy along the default (radial) tangent", "thin film",
+                 "subsurface weight 0.5", "rendered isotropic", "subsurface rendered as diffuse"):
+        assert part in warnings[0]
+
+
+def test_mix_and_add_shaders_are_links_between_nodes(scene, fake_session):
     mat = bpy.data.materials.new("Mixed")
     tree = mat.node_tree
     tree.nodes.remove(tree.nodes["Principled BSDF"])
     diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (1.0, 0.0, 0.0, 1.0)
     glossy = tree.nodes.new("ShaderNodeBsdfAnisotropic")   # "Glossy BSDF"
-    glossy.inputs["Roughness"].default_value = 0.0
     emit = tree.nodes.new("ShaderNodeEmission")
-    emit.inputs["Strength"].default_value = 2.0
     mix = tree.nodes.new("ShaderNodeMixShader")
     mix.inputs[0].default_value = 0.25
     tree.links.new(diffuse.outputs[0], mix.inputs[1])
@@ -141,9 +169,14 @@ def test_mix_and_add_shaders_sum_weighted_closures(scene, fake_session):
     tree.links.new(emit.outputs[0], add.inputs[1])
     tree.links.new(add.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
     m, warnings = exported(fake_session, mat)
-    assert m.base_color == pytest.approx((0.75, 0.0, 0.0))
-    assert m.mirror_color == pytest.approx((0.2, 0.2, 0.2))   # 0.25 x default colour 0.8
-    assert m.emission == pytest.approx((2.0, 2.0, 2.0))
+    out = surface(m)
+    assert out.type == "AddShader"
+    mixed = m.nodes[out.inputs["Shader"].node]
+    assert mixed.type == "MixShader" and mixed.inputs["Fac"] == 0.25
+    assert m.nodes[mixed.inputs["Shader"].node].type == "BsdfDiffuse"
+    assert m.nodes[mixed.inputs["Shader_001"].node].type == "BsdfGlossy"
+    assert m.nodes[out.inputs["Shader_001"].node].type == "Emission"
+    assert all(isinstance(v, Link) for v in out.inputs.values())
     assert warnings == []
 
 
@@ -151,26 +184,32 @@ def test_empty_surface_is_black(scene, fake_session):
     mat = bpy.data.materials.new("Nothing")
     mat.node_tree.nodes.remove(mat.node_tree.nodes["Principled BSDF"])
     m, warnings = exported(fake_session, mat)
-    assert (m.base_color, m.emission, warnings) == ((0, 0, 0), (0, 0, 0), [])
+    assert (m.nodes, m.surface, m.base_color, warnings) == ([], None, (0, 0, 0), [])
 
 
-def test_reroutes_are_followed_and_muted_links_ignored(scene, fake_session):
+def test_reroutes_muted_links_and_muted_nodes(scene, fake_session):
     mat = bpy.data.materials.new("Routed")
     tree = mat.node_tree
     diffuse = replace_surface(mat, "ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (0.1, 0.2, 0.3, 1)
+    emit = tree.nodes.new("ShaderNodeEmission")
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(emit.outputs[0], mix.inputs[2])
     reroute = tree.nodes.new("NodeReroute")
-    tree.links.new(diffuse.outputs[0], reroute.inputs[0])
+    tree.links.new(mix.outputs[0], reroute.inputs[0])
     link = tree.links.new(reroute.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
     m, _ = exported(fake_session, mat)
-    assert m.base_color == pytest.approx((0.1, 0.2, 0.3))
+    assert surface(m).type == "MixShader"
+    mix.mute = True            # a muted Mix Shader passes its first shader through
+    m, _ = exported(fake_session, mat)
+    assert surface(m).type == "BsdfDiffuse"
     link.is_muted = True
     desc = export_scene(fake_session)
-    assert [x.base_color for x in desc.materials if x.name == "Routed"] == [(0, 0, 0)]
+    assert [x.surface for x in desc.materials if x.name == "Routed"] == [None]
 
 
 def test_output_for_eevee_only_is_not_used(scene, fake_session):
-    mat = principled("Split", Base_Color=(0.1, 0.1, 0.1, 1), Specular_IOR_Level=0.0)
+    mat = principled("Split")
     tree = mat.node_tree
     tree.nodes["Material Output"].target = "EEVEE"
     cycles_out = tree.nodes.new("ShaderNodeOutputMaterial")
@@ -178,4 +217,12 @@ def test_output_for_eevee_only_is_not_used(scene, fake_session):
     emission = tree.nodes.new("ShaderNodeEmission")
     tree.links.new(emission.outputs[0], cycles_out.inputs["Surface"])
     m, _ = exported(fake_session, mat)
-    assert (m.base_color, m.emission) == ((0, 0, 0), (1, 1, 1))
+    assert surface(m).type == "Emission"
+
+
+def test_material_settings_cycles_reads(scene, fake_session):
+    mat = principled("Leaf")
+    mat.use_transparent_shadow = False
+    mat.cycles.use_bump_map_correction = False
+    m, _ = exported(fake_session, mat)
+    assert (m.use_transparent_shadow, m.use_bump_map_correction) == (False, False)

@@ -86,11 +86,11 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
     panel_lines = _panel_text(addon, scene)
     assert panel_lines == ["Not rendered yet"]
     bpy.ops.render.render()
-    line = "Lights: 1 sun, 1 emissive triangle; surfaces: diffuse"
+    line = "Lights: 1 sun, 1 emissive triangle; surfaces: diffuse, rough glossy, emission"
     assert scene.mcengine.last_effects == line
-    assert scene.mcengine.last_ignored == "specular, denoising"
+    assert scene.mcengine.last_ignored == "denoising"
     assert _panel_text(addon, scene) == [line,
-                                         "Ignored: specular, denoising"]
+                                         "Ignored: denoising"]
 
 
 def _panel_text(addon, scene, operators=None, props=None):

@@ -1,112 +1,217 @@
-"""Closures: how surfaces scatter light, in a local shading frame.
+"""Closures: how surfaces scatter light, as lists of weighted lobes (Cycles' closures).
 
-A material (``kernels.materials``) is a sum of weighted lobes, as Cycles'
-closures are; this package evaluates and samples them.  One file per family
-of lobes (``fresnel`` holds the interface equations they share); this module
-holds the labels and the dispatch over a material's lobes.
+A shading point's material evaluates (``kernels.svm``) to a short list of
+closures in the array ``cl`` (layout and codes: ``layout``).  One module per
+family computes a closure's ``eval`` (f·|cos θ_i| and pdf) and ``sample`` in
+its local frame: ``diffuse`` (Lambert, Oren–Nayar, translucent),
+``microfacet`` (GGX and Beckmann reflection, refraction and glass, with the
+Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
+``sheen``.  This module combines them as Cycles' surface_shader.h does:
 
-Contract (Mitsuba's): directions are unit vectors in the local frame where the
-shading normal is +z and faces the viewer; ``wo`` points to the viewer, ``wi``
-to the light.  ``backfacing`` says the ray arrived from the inside of the
-surface (relative to its winding), which inverts the index of refraction.
+* ``bsdf_eval``: F = Σ w_k·eval_k over the closures whose pdf is not zero
+  (closures whose label a light excludes add nothing to F but keep their pdf),
+  pdf = Σ sw_k·pdf_k / Σ sw_k — one-sample MIS with the balance heuristic, the
+  transparent closure counting in Σ sw_k only;
+* ``bsdf_sample``: picks closure k with probability sw_k / Σ sw_k, samples it
+  and returns the throughput weight F / pdf of the whole list (for a singular
+  lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes)
+  and the lobe's label.
 
-* ``bsdf_eval(mats, m, wo, wi, exclude)`` returns ``f * |cos(theta_i)|`` per
-  channel of the non-singular lobes and the pdf with which ``bsdf_sample``
-  would have produced ``wi`` (solid angle).  Lobes whose label is in
-  ``exclude`` (a light's ray visibility) add nothing to f but still count in
-  the pdf, as in Cycles;
-* ``bsdf_sample(mats, m, wo, backfacing, u_lobe, u1, u2)`` picks a lobe in
-  proportion to its average colour (Cycles' closure sample weight) and
-  returns ``wi``, the weight ``f * |cos| / pdf`` (one-sample MIS over the
-  non-singular lobes), the pdf (0 for a singular lobe) and the lobe label
-  (``LABEL_*``), which the integrator uses for bounce counting, light
-  visibility and MIS.
+Directions passed here are in world space: ``wo`` towards the viewer, ``wi``
+towards the light or the sampled direction.
 """
 from __future__ import annotations
 
 import math
 
-from ...jit import device
-from ..materials import (
-    M_BASE,
-    M_GLASS,
-    M_IOR,
-    M_MIRROR,
-    M_REFRACT,
-    M_W_DIFFUSE,
-    M_W_GLASS,
-    M_W_MIRROR,
-    M_W_REFRACT,
-    M_W_TOTAL,
+from ...jit import device, function
+from ..sampling import orthonormal_basis
+from .diffuse import (
+    lambert_eval,
+    lambert_sample,
+    oren_nayar_eval,
+    oren_nayar_sample,
+    translucent_eval,
+    translucent_sample,
 )
-from ..sampling import cosine_hemisphere
-from .fresnel import fresnel_dielectric
+from .layout import (
+    CL_N,
+    CL_SW,
+    CL_T,
+    CL_TYPE,
+    CL_W,
+    CT_DIFFUSE,
+    CT_MICROFACET,
+    CT_MICROFACET_GLASS,
+    CT_MICROFACET_REFRACTION,
+    CT_NONE,
+    CT_OREN_NAYAR,
+    CT_SHEEN,
+    CT_TRANSLUCENT,
+    CT_TRANSPARENT,
+    LABEL_DIFFUSE,
+    LABEL_GLOSSY,
+    LABEL_NONE,
+    LABEL_REFLECT,
+    LABEL_SINGULAR,
+    LABEL_TRANSMIT,
+    LABEL_TRANSPARENT,
+)
+from .microfacet import microfacet_eval, microfacet_sample
+from .sheen import sheen_eval, sheen_sample
 
-# Lobe labels (bit flags), as Cycles' LABEL_* (kernel/closure/bsdf.h).
-LABEL_NONE = 0
-LABEL_REFLECT = 1
-LABEL_TRANSMIT = 2
-LABEL_DIFFUSE = 4
-LABEL_GLOSSY = 8
-LABEL_SINGULAR = 16
+__all__ = ["bsdf_eval", "bsdf_sample", "closure_eval", "closure_sample", "LABEL_DIFFUSE",
+           "LABEL_GLOSSY", "LABEL_NONE", "LABEL_REFLECT", "LABEL_SINGULAR", "LABEL_TRANSMIT",
+           "LABEL_TRANSPARENT"]
 
 
 @device
-def bsdf_eval(mats, m, wox, woy, woz, wix, wiy, wiz, exclude):
-    """(f*|cos| r, g, b, pdf) of the non-singular lobes for local wo, wi."""
-    wd = mats[m, M_W_DIFFUSE]
-    if wd <= 0.0 or woz <= 0.0 or wiz <= 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    cos_pi = wiz / math.pi
-    pdf = wd / mats[m, M_W_TOTAL] * cos_pi
-    if exclude & LABEL_DIFFUSE:
-        return 0.0, 0.0, 0.0, pdf
-    return mats[m, M_BASE] * cos_pi, mats[m, M_BASE + 1] * cos_pi, mats[m, M_BASE + 2] * cos_pi, pdf
+def frame(cl, k):
+    """(t, b, n) of closure k: its normal, its tangent and n x t."""
+    nx, ny, nz = cl[k, CL_N], cl[k, CL_N + 1], cl[k, CL_N + 2]
+    tx, ty, tz = cl[k, CL_T], cl[k, CL_T + 1], cl[k, CL_T + 2]
+    if tx == 0.0 and ty == 0.0 and tz == 0.0:
+        tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
+    else:
+        bx, by, bz = ny * tz - nz * ty, nz * tx - nx * tz, nx * ty - ny * tx
+    return tx, ty, tz, bx, by, bz, nx, ny, nz
+
+
+@function
+def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
+    """(r, g, b, pdf) of closure k for world directions, without its weight."""
+    t = cl[k, CL_TYPE]
+    tx, ty, tz, bx, by, bz, nx, ny, nz = frame(cl, k)
+    lox, loy, loz = wox * tx + woy * ty + woz * tz, wox * bx + woy * by + woz * bz, wox * nx + woy * ny + woz * nz
+    lix, liy, liz = wix * tx + wiy * ty + wiz * tz, wix * bx + wiy * by + wiz * bz, wix * nx + wiy * ny + wiz * nz
+    if t == CT_DIFFUSE:
+        return lambert_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    if t == CT_OREN_NAYAR:
+        return oren_nayar_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    if t == CT_TRANSLUCENT:
+        return translucent_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    if t == CT_SHEEN:
+        return sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+        return microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    return 0.0, 0.0, 0.0, 0.0
+
+
+@function
+def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
+    """(wi world, r, g, b, pdf, label) from closure k (r, g, b: eval, or the weight
+    eval / pdf of a singular lobe, which has pdf 0), without the closure's weight."""
+    t = cl[k, CL_TYPE]
+    tx, ty, tz, bx, by, bz, nx, ny, nz = frame(cl, k)
+    lox, loy, loz = wox * tx + woy * ty + woz * tz, wox * bx + woy * by + woz * bz, wox * nx + woy * ny + woz * nz
+    if t == CT_DIFFUSE:
+        x, y, z, r, g, b, pdf, label = lambert_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_OREN_NAYAR:
+        x, y, z, r, g, b, pdf, label = oren_nayar_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_TRANSLUCENT:
+        x, y, z, r, g, b, pdf, label = translucent_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_SHEEN:
+        x, y, z, r, g, b, pdf, label = sheen_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+        x, y, z, r, g, b, pdf, label = microfacet_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_TRANSPARENT:
+        return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
+    else:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+    return (x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz,
+            r, g, b, pdf, label)
 
 
 @device
-def bsdf_sample(mats, m, wox, woy, woz, backfacing, u_lobe, u1, u2):
-    """(wix, wiy, wiz, weight r, g, b, pdf, label) for local wo (woz > 0)."""
-    total = mats[m, M_W_TOTAL]
-    if total <= 0.0 or woz <= 0.0:
+def excluded(t, exclude):
+    """Whether a light's ray-visibility switches (``exclude``, LABEL_* bits) hide
+    closures of type t from it (Cycles' _surface_shader_exclude)."""
+    if exclude == 0:
+        return False
+    if t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT:
+        return (exclude & LABEL_DIFFUSE) != 0
+    if t == CT_MICROFACET:
+        return (exclude & LABEL_GLOSSY) != 0
+    if t == CT_MICROFACET_REFRACTION:
+        return (exclude & LABEL_TRANSMIT) != 0
+    if t == CT_MICROFACET_GLASS:
+        return (exclude & LABEL_GLOSSY) != 0 and (exclude & LABEL_TRANSMIT) != 0
+    return False
+
+
+@device
+def _eval_sum(cl, n, skip, wox, woy, woz, wix, wiy, wiz, exclude, fr, fg, fb, sum_pdf, sum_sw):
+    """Add every closure but ``skip`` to (F, Σ sw·pdf, Σ sw)."""
+    for k in range(n):
+        if k == skip:
+            continue
+        t = cl[k, CL_TYPE]
+        if t == CT_NONE:
+            continue
+        sw = cl[k, CL_SW]
+        sum_sw += sw
+        if t == CT_TRANSPARENT:
+            continue
+        r, g, b, pdf = closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz)
+        if pdf != 0.0:
+            if not excluded(t, exclude):
+                fr += cl[k, CL_W] * r
+                fg += cl[k, CL_W + 1] * g
+                fb += cl[k, CL_W + 2] * b
+            sum_pdf += pdf * sw
+    return fr, fg, fb, sum_pdf, sum_sw
+
+
+@function
+def bsdf_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude):
+    """(F r, g, b, pdf): the closure list's f·|cos| towards wi and its mixture pdf."""
+    fr, fg, fb, sum_pdf, sum_sw = _eval_sum(cl, n, -1, wox, woy, woz, wix, wiy, wiz, exclude,
+                                            0.0, 0.0, 0.0, 0.0, 0.0)
+    return fr, fg, fb, (sum_pdf / sum_sw if sum_sw > 0.0 else 0.0)
+
+
+@function
+def bsdf_sample(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
+    """Sample the closure list: (wi world, weight r, g, b, pdf, label).
+
+    The weight is the path throughput factor F / pdf; pdf is the mixture pdf
+    (0 for a singular lobe, which other closures cannot produce).
+    """
+    total = 0.0
+    for k in range(n):
+        if cl[k, CL_TYPE] != CT_NONE:
+            total += cl[k, CL_SW]
+    if not total > 0.0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-    u = u_lobe * total
-    wd = mats[m, M_W_DIFFUSE]
-    if u < wd:
-        x, y, z = cosine_hemisphere(u1, u2)
-        if z <= 0.0:
-            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-        k = total / wd    # 1 / probability of picking the diffuse lobe
-        return (x, y, z, mats[m, M_BASE] * k, mats[m, M_BASE + 1] * k, mats[m, M_BASE + 2] * k,
-                z / math.pi / k, LABEL_REFLECT | LABEL_DIFFUSE)
-    u -= wd
-    wm = mats[m, M_W_MIRROR]
-    if u < wm:
-        k = total / wm
-        return (-wox, -woy, woz, mats[m, M_MIRROR] * k, mats[m, M_MIRROR + 1] * k,
-                mats[m, M_MIRROR + 2] * k, 0.0, LABEL_REFLECT | LABEL_SINGULAR)
-    u -= wm
-    eta = mats[m, M_IOR]
-    if backfacing:
-        eta = 1.0 / eta
-    wg = mats[m, M_W_GLASS]
-    if u < wg:
-        k = total / wg
-        f, cos_t = fresnel_dielectric(woz, eta)
-        # Reflect with probability F, refract with 1 - F: the Fresnel factor
-        # cancels and both carry the glass colour.
-        if u1 < f:
-            return (-wox, -woy, woz, mats[m, M_GLASS] * k, mats[m, M_GLASS + 1] * k,
-                    mats[m, M_GLASS + 2] * k, 0.0, LABEL_REFLECT | LABEL_SINGULAR)
-        return (-wox / eta, -woy / eta, -cos_t, mats[m, M_GLASS] * k, mats[m, M_GLASS + 1] * k,
-                mats[m, M_GLASS + 2] * k, 0.0, LABEL_TRANSMIT | LABEL_SINGULAR)
-    wr = mats[m, M_W_REFRACT]
-    if wr <= 0.0:
-        # Rounding carried u past the last lobe with weight: no sample.
+    target = u_pick * total
+    acc = 0.0
+    pick = -1
+    for k in range(n):
+        if cl[k, CL_TYPE] == CT_NONE:
+            continue
+        sw = cl[k, CL_SW]
+        if sw > 0.0:
+            pick = k
+            if target < acc + sw:
+                break
+            acc += sw
+    if pick < 0:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-    k = total / wr
-    f, cos_t = fresnel_dielectric(woz, eta)
-    if cos_t <= 0.0:
-        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE   # total internal reflection
-    return (-wox / eta, -woy / eta, -cos_t, mats[m, M_REFRACT] * k, mats[m, M_REFRACT + 1] * k,
-            mats[m, M_REFRACT + 2] * k, 0.0, LABEL_TRANSMIT | LABEL_SINGULAR)
+    sw = cl[pick, CL_SW]
+    wix, wiy, wiz, r, g, b, pdf, label = closure_sample(cl, pick, wox, woy, woz, u1, u2, u3)
+    if label == LABEL_NONE:
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+    if label & (LABEL_SINGULAR | LABEL_TRANSPARENT):
+        k = total / sw
+        return (wix, wiy, wiz, cl[pick, CL_W] * r * k, cl[pick, CL_W + 1] * g * k,
+                cl[pick, CL_W + 2] * b * k, 0.0, label)
+    if not pdf > 0.0:
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+    fr, fg, fb, sum_pdf, sum_sw = _eval_sum(cl, n, pick, wox, woy, woz, wix, wiy, wiz, 0,
+                                            cl[pick, CL_W] * r, cl[pick, CL_W + 1] * g,
+                                            cl[pick, CL_W + 2] * b, pdf * sw, sw)
+    # sum_sw now counts every closure once (the picked one was given as the start).
+    mix_pdf = sum_pdf / sum_sw
+    if not (mix_pdf > 0.0 and math.isfinite(mix_pdf)):
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+    return wix, wiy, wiz, fr / mix_pdf, fg / mix_pdf, fb / mix_pdf, mix_pdf, label

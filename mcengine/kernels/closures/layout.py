@@ -1,0 +1,84 @@
+"""The closure list: how a shading point's closures are stored, and their codes.
+
+Evaluating a material at a shading point (``kernels.svm``) produces a short
+list of closures, as Cycles does (kernel/closure/alloc.h): each is one row of
+a float64 array ``cl`` of shape (MAX_CLOSURES, CL_STRIDE), owned by the worker
+thread and overwritten at every hit.  A row holds the closure's type, its
+weight (colour, mix factors, layering, energy-compensation darkening), its
+sample weight (the probability of picking it, unnormalised), its shading frame
+and its parameters.  Every closure module reads the columns it needs.
+
+Directions: ``wo`` points to the viewer (Cycles' ``sd->wi``), ``wi`` to the
+light or the sampled direction (Cycles' ``wo``).  In a closure's local frame
+the normal ``CL_N`` is +z and the tangent ``CL_T`` is +x.
+
+Codes
+-----
+``CT_*``  closure types (which module evaluates the row)
+``FR_*``  Fresnel models of microfacet closures (kernel/closure/bsdf_microfacet.h)
+``MD_*``  microfacet distributions
+``LABEL_*`` lobe labels of a sample, as Cycles' LABEL_* (kernel/closure/bsdf.h)
+"""
+from __future__ import annotations
+
+MAX_CLOSURES = 16        # Principled + Mix of two Principled stays below 16 (Cycles allows 64)
+
+# -- columns of a closure row ------------------------------------------------------------------
+CL_TYPE = 0              # CT_* code
+CL_W = 1                 # 3: weight RGB (what eval/sample results are multiplied by)
+CL_SW = 4                # sample weight (>= 0): probability of picking the closure, unnormalised
+CL_N = 5                 # 3: unit normal, world space, on the viewer's side
+CL_T = 8                 # 3: unit tangent, world space, orthogonal to CL_N (the frame's +x)
+CL_AX = 11               # microfacet alpha along the tangent (alpha = roughness^2)
+CL_AY = 12               # microfacet alpha along the bitangent
+CL_ETA = 13              # relative index of refraction (inside / outside; 1/IOR on back faces)
+CL_DIST = 14             # MD_* distribution
+CL_FRESNEL = 15          # FR_* Fresnel model
+CL_F0 = 16               # 3: reflectance at normal incidence (Schlick, F82)
+CL_F90 = 19              # 3: generalized Schlick: reflectance at grazing incidence; F82: B term
+CL_EXPONENT = 22         # generalized Schlick exponent (< 0: remap the real Fresnel curve)
+CL_RTINT = 23            # 3: reflection tint
+CL_TTINT = 26            # 3: transmission tint
+CL_ENERGY = 29           # multiple-scattering energy scale 1 + (1 - E) / E (1: none)
+CL_P0 = 30               # closure-specific parameters (Oren-Nayar A, B, multiscatter RGB;
+CL_P1 = 31               # sheen LTC a, b)
+CL_P2 = 32
+CL_P3 = 33
+CL_P4 = 34
+CL_STRIDE = 36
+
+# -- closure types -------------------------------------------------------------------------------
+CT_NONE = 0
+CT_DIFFUSE = 1           # Lambert: f = 1/pi
+CT_OREN_NAYAR = 2        # Fujii's improved Oren-Nayar with the OpenPBR multiple-scatter term
+CT_TRANSLUCENT = 3       # Lambert on the far side
+CT_SHEEN = 4             # Zeltner et al. 2022 microfibre sheen (LTC)
+CT_MICROFACET = 5        # rough (or smooth) reflection only
+CT_MICROFACET_REFRACTION = 6   # rough (or smooth) refraction only
+CT_MICROFACET_GLASS = 7  # reflection and refraction, split by Fresnel
+CT_TRANSPARENT = 8       # straight pass-through (a transparent bounce)
+
+# -- Fresnel models --------------------------------------------------------------------------
+FR_NONE = 0              # reflectance 1 (the weight carries the colour), no TIR handling
+FR_DIELECTRIC = 1        # exact unpolarised dielectric Fresnel with CL_ETA
+FR_SCHLICK = 2           # generalized Schlick: mix(F0, F90, s) x tints
+FR_F82 = 3               # F82-tint conductor: Schlick(F0) - B cos (1 - cos)^6
+
+# -- microfacet distributions ------------------------------------------------------------------
+MD_GGX = 0
+MD_BECKMANN = 1
+
+# -- lobe labels (bit flags) -------------------------------------------------------------------
+LABEL_NONE = 0
+LABEL_REFLECT = 1
+LABEL_TRANSMIT = 2
+LABEL_DIFFUSE = 4
+LABEL_GLOSSY = 8
+LABEL_SINGULAR = 16
+LABEL_TRANSPARENT = 32
+
+# alpha_x * alpha_y at or below this is a singular (perfectly smooth) lobe: it can only be
+# sampled, never evaluated (Cycles' BSDF_ROUGHNESS_SQ_THRESH; roughness about 0.0038).
+ROUGHNESS_SQ_THRESHOLD = 2e-10
+# Closures with |average weight| below this are not allocated (Cycles' CLOSURE_WEIGHT_CUTOFF).
+CLOSURE_WEIGHT_CUTOFF = 1e-5

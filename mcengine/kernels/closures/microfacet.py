@@ -37,7 +37,9 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device
+from numba import njit
+
+from ...jit import _cached, device
 from .fresnel import (
     F0_from_ior,
     f82_tint_B,
@@ -45,7 +47,6 @@ from .fresnel import (
     fresnel_dielectric_Fss,
     fresnel_f82,
     fresnel_f82_Fss,
-    generalized_schlick_s,
 )
 from .layout import (
     CL_AX,
@@ -77,18 +78,22 @@ from .layout import (
     ROUGHNESS_SQ_THRESHOLD,
 )
 from .tables import (
-    GGX_E,
-    GGX_EAVG,
+    GGX_E_3D,
+    GGX_EAVG_2D,
     GGX_GEN_SCHLICK_IOR_S,
     GGX_GEN_SCHLICK_S,
     GGX_GLASS_E,
     GGX_GLASS_EAVG,
     GGX_GLASS_INV_E,
     GGX_GLASS_INV_EAVG,
-    lookup_1d,
     lookup_2d,
     lookup_3d,
 )
+
+# Called, not inlined: the Beckmann sampler (and its erfinv) costs about 0.5 us, and the setup
+# helpers (albedo estimate, energy compensation: table lookups) run once per closure, so a call
+# costs nothing measurable, while inlining them would add seconds to every kernel's compilation.
+device_call = _cached(njit(cache=True, error_model="numpy", _nrt=False))
 
 _INV_PI = 1.0 / math.pi
 _SQRT_PI = math.sqrt(math.pi)
@@ -216,7 +221,7 @@ def ggx_sample_vndf(vx, vy, vz, ax, ay, u1, u2):
     return hx * inv, hy * inv, hz * inv
 
 
-@device
+@device_call
 def erfinv(y):
     """Inverse error function to double precision, for y in (-1, 1) (clamped inside).
 
@@ -245,7 +250,7 @@ def erfinv(y):
     return sign * x
 
 
-@device
+@device_call
 def beckmann_sample_vndf(vx, vy, vz, ax, ay, u1, u2):
     """A Beckmann normal h with density G1(v) max(0, v.h) D(h) / v_z (Heitz & d'Eon 2014).
 
@@ -339,16 +344,24 @@ def microfacet_fresnel(cl, k, cos_hi):
     has_t = 1.0 if ctype != CT_MICROFACET else 0.0
     model = int(cl[k, CL_FRESNEL])
     eta = cl[k, CL_ETA]
-    cos_t = 0.0
+    # the exact dielectric Fresnel, computed once (cheap) and used by three of the models
+    f_real, cos_t = fresnel_dielectric(cos_hi, eta)
     if model == FR_DIELECTRIC:
-        f, cos_t = fresnel_dielectric(cos_hi, eta)
-        rr = rg = rb = f
-        tr = tg = tb = 1.0 - f
+        rr = rg = rb = f_real
+        tr = tg = tb = 1.0 - f_real
     elif model == FR_SCHLICK:
-        s, cos_t, tir = generalized_schlick_s(cos_hi, eta, cl[k, CL_EXPONENT])
-        if tir:
-            return (cl[k, CL_RTINT] * has_r, cl[k, CL_RTINT + 1] * has_r, cl[k, CL_RTINT + 2] * has_r,
-                    0.0, 0.0, 0.0, 0.0)
+        e = cl[k, CL_EXPONENT]
+        if e < 0.0:
+            f0 = F0_from_ior(eta)
+            s = min(max((f_real - f0) / (1.0 - f0), 0.0), 1.0)
+        else:
+            c = abs(cos_hi)
+            cos_t_sq = 1.0 - (1.0 - c * c) / (eta * eta)
+            if cos_t_sq <= 0.0:          # total internal reflection: the reflection tint alone
+                return (cl[k, CL_RTINT] * has_r, cl[k, CL_RTINT + 1] * has_r, cl[k, CL_RTINT + 2] * has_r,
+                        0.0, 0.0, 0.0, 0.0)
+            cos_t = math.sqrt(cos_t_sq)
+            s = (1.0 - (cos_t if eta < 1.0 else c)) ** e
         fr = cl[k, CL_F0] + (cl[k, CL_F90] - cl[k, CL_F0]) * s
         fg = cl[k, CL_F0 + 1] + (cl[k, CL_F90 + 1] - cl[k, CL_F0 + 1]) * s
         fb = cl[k, CL_F0 + 2] + (cl[k, CL_F90 + 2] - cl[k, CL_F0 + 2]) * s
@@ -359,17 +372,19 @@ def microfacet_fresnel(cl, k, cos_hi):
         tg = (1.0 - fg) * cl[k, CL_TTINT + 1]
         tb = (1.0 - fb) * cl[k, CL_TTINT + 2]
     elif model == FR_F82:
-        rr = fresnel_f82(cos_hi, cl[k, CL_F0], cl[k, CL_F90])
-        rg = fresnel_f82(cos_hi, cl[k, CL_F0 + 1], cl[k, CL_F90 + 1])
-        rb = fresnel_f82(cos_hi, cl[k, CL_F0 + 2], cl[k, CL_F90 + 2])
+        rr = rg = rb = 0.0
+        for c in range(3):
+            v = fresnel_f82(cos_hi, cl[k, CL_F0 + c], cl[k, CL_F90 + c])
+            if c == 0:
+                rr = v
+            elif c == 1:
+                rg = v
+            else:
+                rb = v
         tr = tg = tb = 0.0
     else:
         rr = rg = rb = 1.0
-        tr = tg = tb = 1.0
-        if has_t > 0.0:
-            f, cos_t = fresnel_dielectric(cos_hi, eta)
-            if f == 1.0:
-                tr = tg = tb = 0.0
+        tr = tg = tb = 1.0 if f_real < 1.0 else 0.0      # no transmission under TIR
     return (rr * has_r, rg * has_r, rb * has_r, tr * has_t, tg * has_t, tb * has_t, cos_t)
 
 
@@ -554,7 +569,7 @@ def _ior_z(eta):
     return math.sqrt(abs((eta - 1.0) / (eta + 1.0)))
 
 
-@device
+@device_call
 def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     """Estimated albedo RGB (R + T, without CL_W) for a view at cosine cos_no (Cycles' bsdf_microfacet_estimate_albedo).
 
@@ -573,30 +588,35 @@ def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     if rr == 0.0 and rg == 0.0 and rb == 0.0:
         return tr, tg, tb
     model = int(cl[k, CL_FRESNEL])
-    rough = math.sqrt(math.sqrt(cl[k, CL_AX] * cl[k, CL_AY]))
     eta = cl[k, CL_ETA]
     if model == FR_SCHLICK:
         e = cl[k, CL_EXPONENT]
-        if e < 0.0:
-            s = lookup_3d(GGX_GEN_SCHLICK_IOR_S, rough, cos_no, _ior_z(eta))
-        else:
-            s = lookup_3d(GGX_GEN_SCHLICK_S, rough, cos_no, 1.0 / (0.2 * e + 1.0))
+        table = GGX_GEN_SCHLICK_IOR_S if e < 0.0 else GGX_GEN_SCHLICK_S
+        z = _ior_z(eta) if e < 0.0 else 1.0 / (0.2 * e + 1.0)
+    elif model == FR_F82:
+        table = GGX_GEN_SCHLICK_S
+        z = 0.5
+    elif model == FR_DIELECTRIC and eta > 1.0:
+        table = GGX_GEN_SCHLICK_IOR_S
+        z = _ior_z(eta)
+    else:
+        return rr + tr, rg + tg, rb + tb
+    s = lookup_3d(table, math.sqrt(math.sqrt(cl[k, CL_AX] * cl[k, CL_AY])), cos_no, z)
+    if model == FR_SCHLICK:
         rr = (cl[k, CL_F0] + (cl[k, CL_F90] - cl[k, CL_F0]) * s) * cl[k, CL_RTINT]
         rg = (cl[k, CL_F0 + 1] + (cl[k, CL_F90 + 1] - cl[k, CL_F0 + 1]) * s) * cl[k, CL_RTINT + 1]
         rb = (cl[k, CL_F0 + 2] + (cl[k, CL_F90 + 2] - cl[k, CL_F0 + 2]) * s) * cl[k, CL_RTINT + 2]
     elif model == FR_F82:
-        s = lookup_3d(GGX_GEN_SCHLICK_S, rough, cos_no, 0.5)
         rr = cl[k, CL_F0] + (1.0 - cl[k, CL_F0]) * s
         rg = cl[k, CL_F0 + 1] + (1.0 - cl[k, CL_F0 + 1]) * s
         rb = cl[k, CL_F0 + 2] + (1.0 - cl[k, CL_F0 + 2]) * s
-    elif model == FR_DIELECTRIC and eta > 1.0:
-        s = lookup_3d(GGX_GEN_SCHLICK_IOR_S, rough, cos_no, _ior_z(eta))
+    else:
         f0 = F0_from_ior(eta)
         rr = rg = rb = f0 + (1.0 - f0) * s
     return rr + tr, rg + tg, rb + tb
 
 
-@device
+@device_call
 def microfacet_albedo_tables(cl, k, cos_no):
     """(E, E_avg) of the energy-compensation tables for this row (1, 1 when it has none).
 
@@ -607,20 +627,21 @@ def microfacet_albedo_tables(cl, k, cos_no):
     if int(cl[k, CL_DIST]) != MD_GGX:
         return 1.0, 1.0
     ctype = int(cl[k, CL_TYPE])
-    rough = math.sqrt(math.sqrt(cl[k, CL_AX] * cl[k, CL_AY]))
     if ctype == CT_MICROFACET:
-        return lookup_2d(GGX_E, rough, cos_no), lookup_1d(GGX_EAVG, rough)
-    if ctype == CT_MICROFACET_GLASS:
+        e_table, avg_table, z = GGX_E_3D, GGX_EAVG_2D, 0.0
+    elif ctype == CT_MICROFACET_GLASS:
         eta = cl[k, CL_ETA]
         if eta < 1.0:
-            z = _ior_z(1.0 / eta)
-            return lookup_3d(GGX_GLASS_INV_E, rough, cos_no, z), lookup_2d(GGX_GLASS_INV_EAVG, rough, z)
-        z = _ior_z(eta)
-        return lookup_3d(GGX_GLASS_E, rough, cos_no, z), lookup_2d(GGX_GLASS_EAVG, rough, z)
-    return 1.0, 1.0
+            e_table, avg_table, z = GGX_GLASS_INV_E, GGX_GLASS_INV_EAVG, _ior_z(1.0 / eta)
+        else:
+            e_table, avg_table, z = GGX_GLASS_E, GGX_GLASS_EAVG, _ior_z(eta)
+    else:
+        return 1.0, 1.0
+    rough = math.sqrt(math.sqrt(cl[k, CL_AX] * cl[k, CL_AY]))
+    return lookup_3d(e_table, rough, cos_no, z), lookup_2d(avg_table, rough, z)
 
 
-@device
+@device_call
 def microfacet_preserve_energy(cl, k, cos_no, fss_r, fss_g, fss_b):
     """Multiple-scattering compensation (Cycles' microfacet_ggx_preserve_energy).
 

@@ -75,6 +75,10 @@ GGX_GLASS_INV_EAVG, _ok5 = _load("ggx_glass_inv_Eavg")
 GGX_GEN_SCHLICK_IOR_S, _ok6 = _load("ggx_gen_schlick_ior_s")
 GGX_GEN_SCHLICK_S, _ok7 = _load("ggx_gen_schlick_s")
 TABLES_LOADED = all((_ok0, _ok1, _ok2, _ok3, _ok4, _ok5, _ok6, _ok7))
+# GGX_E and GGX_EAVG with a leading axis of one node, so that a single lookup_3d / lookup_2d
+# site reads either them (z = 0) or the glass tables.
+GGX_E_3D = np.ascontiguousarray(GGX_E[None])
+GGX_EAVG_2D = np.ascontiguousarray(GGX_EAVG[None])
 
 
 @device

@@ -37,9 +37,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
-from ...jit import _cached, device
+from ...jit import device, function
 from .fresnel import (
     F0_from_ior,
     f82_tint_B,
@@ -90,10 +88,10 @@ from .tables import (
     lookup_3d,
 )
 
-# Called, not inlined: the Beckmann sampler (and its erfinv) costs about 0.5 us, and the setup
-# helpers (albedo estimate, energy compensation: table lookups) run once per closure, so a call
-# costs nothing measurable, while inlining them would add seconds to every kernel's compilation.
-device_call = _cached(njit(cache=True, error_model="numpy", _nrt=False))
+# ``function`` (called, not inlined): the Beckmann sampler (and its erfinv) costs about 0.5 us,
+# and the setup helpers (albedo estimate, energy compensation: table lookups) run once per
+# closure, so a call costs nothing measurable, while inlining them would add seconds to every
+# kernel's compilation.
 
 _INV_PI = 1.0 / math.pi
 _SQRT_PI = math.sqrt(math.pi)
@@ -221,7 +219,7 @@ def ggx_sample_vndf(vx, vy, vz, ax, ay, u1, u2):
     return hx * inv, hy * inv, hz * inv
 
 
-@device_call
+@function
 def erfinv(y):
     """Inverse error function to double precision, for y in (-1, 1) (clamped inside).
 
@@ -250,7 +248,7 @@ def erfinv(y):
     return sign * x
 
 
-@device_call
+@function
 def beckmann_sample_vndf(vx, vy, vz, ax, ay, u1, u2):
     """A Beckmann normal h with density G1(v) max(0, v.h) D(h) / v_z (Heitz & d'Eon 2014).
 
@@ -569,7 +567,7 @@ def _ior_z(eta):
     return math.sqrt(abs((eta - 1.0) / (eta + 1.0)))
 
 
-@device_call
+@function
 def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     """Estimated albedo RGB (R + T, without CL_W) for a view at cosine cos_no (Cycles' bsdf_microfacet_estimate_albedo).
 
@@ -616,7 +614,7 @@ def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     return rr + tr, rg + tg, rb + tb
 
 
-@device_call
+@function
 def microfacet_albedo_tables(cl, k, cos_no):
     """(E, E_avg) of the energy-compensation tables for this row (1, 1 when it has none).
 
@@ -641,7 +639,7 @@ def microfacet_albedo_tables(cl, k, cos_no):
     return lookup_3d(e_table, rough, cos_no, z), lookup_2d(avg_table, rough, z)
 
 
-@device_call
+@function
 def microfacet_preserve_energy(cl, k, cos_no, fss_r, fss_g, fss_b):
     """Multiple-scattering compensation (Cycles' microfacet_ggx_preserve_energy).
 

@@ -17,4 +17,7 @@ setup(
         + [f"{ADDON_PACKAGE}.{name}" for name in find_packages(ADDON_FOLDER)]
     ),
     package_dir={ADDON_PACKAGE: ADDON_FOLDER},
+    # The closures' tables (energy compensation, albedo estimates, sheen) are data the
+    # kernels freeze into their compiled code; wheels and the extension must carry them.
+    package_data={"mcengine.kernels.closures": ["data/*.npy"]},
 )

@@ -272,7 +272,7 @@ def _whitted_children(cl, ncl, sp, dx, dy, dz, nx, n_next, st, i, key, br, bg, b
             if refract:
                 wr_, wg_, wb_ = tr, tg, tb
                 inv = 1.0 / eta
-                a = inv * cos_i - cos_t     # refract_angle with cos_t as Cycles signs it (<= 0)
+                a = inv * cos_i - cos_t     # Cycles' refract_angle (its cos_t is -ours)
                 wix, wiy, wiz = dx * inv + a * nx_, dy * inv + a * ny_, dz * inv + a * nz_
                 label = LABEL_TRANSMIT | LABEL_SINGULAR
             else:

@@ -377,7 +377,7 @@ def transparent(cl, n, wr, wg, wb, sd):
     return n + 1
 
 
-@device
+@function
 def diffuse(cl, k, sd, nx, ny, nz, roughness, albedo_r, albedo_g, albedo_b):
     """Lambert below roughness 1e-5, else Oren-Nayar with the (saturated) colour."""
     set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
@@ -389,7 +389,7 @@ def diffuse(cl, k, sd, nx, ny, nz, roughness, albedo_r, albedo_g, albedo_b):
                          albedo_r, albedo_g, albedo_b)
 
 
-@device
+@function
 def sheen(cl, k, sd, nx, ny, nz, roughness):
     """Microfibre sheen; returns False (and removes the weight) where its LTC is invalid."""
     cl[k, CL_TYPE] = CT_SHEEN
@@ -397,7 +397,7 @@ def sheen(cl, k, sd, nx, ny, nz, roughness):
     return sheen_setup(cl, k, sd.wox, sd.woy, sd.woz, roughness)
 
 
-@device
+@function
 def glossy(regs, b, cl, n, sd, cr, cg, cb):
     """Glossy BSDF: microfacet reflection, F = 1, Color as the weight; Multiscatter GGX
     compensates energy with Fss = Color (Cycles' bsdf_microfacet_setup_fresnel_constant)."""
@@ -428,7 +428,7 @@ def glossy(regs, b, cl, n, sd, cr, cg, cb):
     return n
 
 
-@device
+@function
 def glass(regs, b, w, cl, n, sd):
     """Glass BSDF: rough dielectric, Schlick remap of the real Fresnel (exact at F0 of the
     IOR), Color tinting reflection and refraction; Multiscatter GGX compensates energy."""

@@ -1,0 +1,100 @@
+"""Small material set-ups with Cycles' measured answers (the oracles), shared by the test
+``test_material_oracles.py`` (MC Engine, no Blender) and the script
+``tools/measure_material_oracles.py`` (which renders the same set-ups with Cycles
+and writes ``material_oracles.json``).
+
+The set-up is the reference's (cycles-conventions.md, experiment defaults): a
+large plane at z = 0 with the material, an orthographic camera looking at the
+origin from ``view`` degrees off the normal (in the x-z plane, from +x), a Box
+pixel filter, and either a 1000 W point light of radius 0 at distance 2 m,
+``light`` degrees off the normal (azimuth 0: the camera's side, 180: opposite)
+with max_bounces 0, or (``light`` None) a white world of strength 1 with 64
+bounces: a furnace.
+"""
+from __future__ import annotations
+
+import math
+
+# name: (nodes, view_deg, (light_theta_deg, light_azimuth_deg) or None)
+# nodes: list of (type, inputs, props); the last node feeds the Surface socket,
+# inputs of the form ("link", k) take node k's output.
+ORACLES = {
+    "principled_defaults": ([("BsdfPrincipled", {}, {})], 0.0, (0.0, 0.0)),
+    "principled_white": ([("BsdfPrincipled", {"Base Color": (1, 1, 1)}, {})], 0.0, (0.0, 0.0)),
+    "principled_metal": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Metallic": 1.0}, {})],
+                         0.0, (0.0, 0.0)),
+    "principled_metal_ggx": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Metallic": 1.0},
+                               {"distribution": "GGX"})], 0.0, (0.0, 0.0)),
+    "principled_gold_45": ([("BsdfPrincipled", {"Base Color": (1.0, 0.78, 0.34), "Metallic": 1.0,
+                                                "Roughness": 0.3,
+                                                "Specular Tint": (1.0, 0.8, 0.6)}, {})],
+                           45.0, (30.0, 180.0)),
+    "principled_plastic_45": ([("BsdfPrincipled", {"Base Color": (0.2, 0.4, 0.8), "Roughness": 0.2,
+                                                   "Specular IOR Level": 0.8, "IOR": 1.6}, {})],
+                              45.0, (45.0, 180.0)),
+    "principled_coat": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Specular IOR Level": 0.0,
+                                             "Coat Weight": 1.0, "Coat Roughness": 0.5,
+                                             "Coat Tint": (0.5, 0.5, 0.5)}, {})],
+                        45.0, (0.0, 0.0)),
+    "principled_sheen": ([("BsdfPrincipled", {"Base Color": (0.05, 0.05, 0.3), "Sheen Weight": 1.0,
+                                              "Sheen Roughness": 0.3}, {})], 60.0, (50.0, 180.0)),
+    "principled_transmission": ([("BsdfPrincipled", {"Transmission Weight": 1.0, "Roughness": 0.3,
+                                                     "Base Color": (0.8, 1.0, 0.8)}, {})],
+                                30.0, (20.0, 180.0)),
+    "principled_alpha": ([("BsdfPrincipled", {"Alpha": 0.3, "Specular IOR Level": 0.0}, {})],
+                         0.0, (0.0, 0.0)),
+    "principled_rough_diffuse": ([("BsdfPrincipled", {"Diffuse Roughness": 1.0,
+                                                      "Specular IOR Level": 0.0}, {})],
+                                 45.0, (60.0, 0.0)),
+    "principled_emission_coat": ([("BsdfPrincipled", {"Base Color": (0, 0, 0), "Coat Weight": 1.0,
+                                                      "Specular IOR Level": 0.0,
+                                                      "Emission Strength": 5.0}, {})],
+                                 0.0, (30.0, 0.0)),
+    "diffuse_rough_same_side": ([("BsdfDiffuse", {"Roughness": 1.0}, {})], 45.0, (60.0, 0.0)),
+    "diffuse_rough_opposite": ([("BsdfDiffuse", {"Roughness": 0.5}, {})], 45.0, (60.0, 180.0)),
+    "glossy_ggx_40": ([("BsdfGlossy", {"Color": (1, 1, 1)}, {"distribution": "GGX"})],
+                      0.0, (40.0, 0.0)),
+    "glossy_beckmann_40": ([("BsdfGlossy", {"Color": (1, 1, 1)}, {"distribution": "BECKMANN"})],
+                           0.0, (40.0, 0.0)),
+    "glossy_multi": ([("BsdfGlossy", {"Color": (1, 1, 1)}, {})], 0.0, (0.0, 0.0)),
+    "glass_rough_back_light": ([("BsdfGlass", {"Roughness": 0.4}, {})], 20.0, (150.0, 180.0)),
+    "refraction_rough": ([("BsdfRefraction", {"Roughness": 0.3}, {"distribution": "GGX"})],
+                         10.0, (160.0, 180.0)),
+    "translucent": ([("BsdfTranslucent", {"Color": (0.9, 0.6, 0.3)}, {})], 0.0, (170.0, 0.0)),
+    "sheen_node": ([("BsdfSheen", {"Roughness": 0.5, "Color": (1, 1, 1)}, {})], 0.0, (0.0, 0.0)),
+    "holdout_mix": ([("Holdout", {}, {}), ("BsdfDiffuse", {"Color": (1, 1, 1)}, {}),
+                     ("MixShader", {"Fac": 0.75, "Shader": ("link", 0), "Shader_001": ("link", 1)}, {})],
+                    0.0, (0.0, 0.0)),
+    "furnace_principled": ([("BsdfPrincipled", {"Base Color": (1, 1, 1)}, {})], 30.0, None),
+    "furnace_principled_rough": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Roughness": 1.0}, {})],
+                                 30.0, None),
+    "furnace_metal_rough": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Metallic": 1.0,
+                                                 "Roughness": 1.0}, {})], 0.0, None),
+    "furnace_metal_rough_ggx": ([("BsdfPrincipled", {"Base Color": (1, 1, 1), "Metallic": 1.0,
+                                                     "Roughness": 1.0}, {"distribution": "GGX"})],
+                                0.0, None),
+    "furnace_glass": ([("BsdfGlass", {"Roughness": 0.5}, {})], 30.0, None),
+}
+
+LIGHT_WATTS = 1000.0
+LIGHT_DISTANCE = 2.0
+
+
+def light_position(theta_deg, azimuth_deg):
+    """Point-light position: theta off the +z normal, azimuth 0 on the camera's side (+x)."""
+    t, a = math.radians(theta_deg), math.radians(azimuth_deg)
+    return (LIGHT_DISTANCE * math.sin(t) * math.cos(a), LIGHT_DISTANCE * math.sin(t) * math.sin(a),
+            LIGHT_DISTANCE * math.cos(t))
+
+
+def camera_matrix(view_deg, distance=5.0):
+    """4x4 world matrix of a camera looking at the origin from view_deg off +z, on the +x side."""
+    t = math.radians(view_deg)
+    back = (math.sin(t), 0.0, math.cos(t))            # camera local +Z (it looks along -Z)
+    up = (-math.cos(t), 0.0, math.sin(t))             # camera local +Y
+    right = (up[1] * back[2] - up[2] * back[1], up[2] * back[0] - up[0] * back[2],
+             up[0] * back[1] - up[1] * back[0])
+    return [[right[0], up[0], back[0], distance * back[0]],
+            [right[1], up[1], back[1], distance * back[1]],
+            [right[2], up[2], back[2], distance * back[2]],
+            [0.0, 0.0, 0.0, 1.0]]

@@ -21,8 +21,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mcengine.scene import (Camera, Film, Geometry, Integrator, Light, Link, Material,
-                            SceneDescription, ShaderNode, World)
+from mcengine.scene import (
+    Camera,
+    Film,
+    Geometry,
+    Integrator,
+    Light,
+    Link,
+    Material,
+    SceneDescription,
+    ShaderNode,
+    World,
+)
 
 from .expect import image_mean_and_se, render
 from .material_oracles import LIGHT_WATTS, ORACLES, camera_matrix, light_position

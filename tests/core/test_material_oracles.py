@@ -95,3 +95,23 @@ def test_material_in_a_white_furnace_matches_cycles(name):
 def test_oracles_were_measured_for_every_set_up():
     assert set(MEASURED) == set(ORACLES)
     assert all(math.isfinite(v) for m in MEASURED.values() for v in m["rgba"])
+
+
+@pytest.mark.parametrize("transparent_shadow", [True, False])
+def test_transparent_shadows_take_the_colour_of_the_surface_they_pass(transparent_shadow):
+    """Cycles (measured, cycles-closures.md 7): a Transparent BSDF of colour (.5, .25, 1)
+    between a 1000 W point light and a white plane 2 m below it lets colour x 6.33257 through
+    (3.16627, 1.58313, 6.33253); with the material's Transparent Shadows off, nothing."""
+    scene = oracle_scene("principled_white")
+    scene.materials = [Material(name="white", base_color=(1.0, 1.0, 1.0)),
+                       Material(name="filter", nodes=[ShaderNode("BsdfTransparent",
+                                                                 {"Color": (0.5, 0.25, 1.0)})],
+                                surface=Link(0, "BSDF"), use_transparent_shadow=transparent_shadow)]
+    s = 0.3
+    card = np.array([[[-s, -s, 1.0], [s, -s, 1.0], [s, s, 1.0]], [[-s, -s, 1.0], [s, s, 1.0], [-s, s, 1.0]]])
+    plane = scene.geometry
+    scene.geometry = Geometry.concatenate([plane, Geometry.from_triangles(card, material_index=[1, 1])])
+    scene.camera.matrix_world = np.array(camera_matrix(20.0))   # the camera sees past the card
+    img = render(scene).image().astype(np.float64).reshape(-1, 4).mean(axis=0)
+    expected = np.array([0.5, 0.25, 1.0]) * 6.33257 * math.cos(0.0) if transparent_shadow else 0.0
+    np.testing.assert_allclose(img[:3], expected, rtol=2e-3, atol=1e-6)

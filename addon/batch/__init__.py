@@ -6,7 +6,10 @@
 * ``settings``: the scene settings these tools change (overrides for one
   render, the unbiased settings of a comparison) and putting them back;
 * ``comparison``: MC Engine against Cycles on a scene, a file or a folder;
-* ``study``: accuracy against time on a scene or a file.
+* ``study``: accuracy against time on a scene or a file;
+* ``outputs``: files written atomically (temporary file, checked, renamed);
+* ``interrupt``: the stop flag that the command line's signal handlers set and
+  that these tools and MC Engine renders honour.
 
 The command line (``cli``), the operators, the tests and the benchmark use
 them; the numbers and files come from :mod:`mcengine.evaluation`.  Importing

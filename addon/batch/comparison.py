@@ -27,6 +27,7 @@ from mcengine.evaluation.comparison import EngineRuns, SuiteRow, build_compariso
 from mcengine.evaluation.output import write_comparison, write_suite
 from mcengine.integrators import INTEGRATORS
 
+from .outputs import OutputError, write_folder
 from .render import ENGINES, OpenError, ensure_registered, error_message, open_scene, render_scene
 from .settings import apply_overrides, make_unbiased, restoring
 
@@ -120,7 +121,8 @@ def _render_runs(scene, engine: str, options: CompareOptions, size, render, on_r
                          f"Where these matter, \"differ\" is expected.")
     return EngineRuns(images=np.stack([r.image for r in renders]),
                       seconds=[r.seconds for r in renders], samples=renders[0].samples,
-                      seeds=seeds, notes=notes)
+                      seeds=seeds, notes=notes,
+                      nonfinite=sum(int(getattr(r, "nonfinite", 0) or 0) for r in renders))
 
 
 def _check_seeds(options: CompareOptions) -> None:
@@ -203,7 +205,10 @@ def run_suite(folder, options: CompareOptions, out_dir, *, render=render_scene,
     """Compare every .blend in ``folder``; write per-scene folders and the summary.
 
     Scene ``NAME.blend`` gets the folder ``out_dir/NAME``.  A scene whose
-    comparison fails becomes an "error" row; the others still run.
+    comparison fails (or whose files cannot be written) becomes an "error"
+    row; the others still run.  Every file is written to a temporary file
+    first and renamed into place once complete (:mod:`.outputs`), so files of
+    an earlier run are replaced whole or not at all.
 
     Parameters
     ----------
@@ -229,12 +234,12 @@ def run_suite(folder, options: CompareOptions, out_dir, *, render=render_scene,
         started = time.perf_counter()
         try:
             comparison = compare_file(path, options, render=render, on_render=on_render)
-            write_comparison(comparison, out / path.stem)
+            write_folder(write_comparison, comparison, out / path.stem)
             rows.append(suite_row(comparison, path.stem))
-        except CompareError as exc:
+        except (CompareError, OutputError) as exc:
             rows.append(SuiteRow(scene=path.stem, verdict="error", folder=path.stem,
                                  error=str(exc)))
         rows[-1].wall_seconds = time.perf_counter() - started
         if on_done is not None:
             on_done(rows[-1])
-    return rows, write_suite(rows, out)
+    return rows, write_folder(write_suite, rows, out)

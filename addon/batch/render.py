@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import interrupt
 from .settings import apply_overrides, set_image_format
 
 __all__ = ["ENGINES", "Render", "OpenError", "NoSuchScene", "open_scene", "ensure_registered",
@@ -36,6 +37,7 @@ class Render:
     engine: str
     samples: int
     seed: int
+    nonfinite: int = 0      # MC Engine: samples dropped as NaN or infinite
 
 
 class OpenError(Exception):
@@ -88,16 +90,22 @@ def render_scene(scene, engine: str, *, samples=None, seed=None, resolution=None
     """Render the given (already loaded) scene; settings are changed in memory only.
 
     ``engine`` is a name of :data:`ENGINES` or a bl_idname; None settings keep
-    the scene's.  Raises RuntimeError (Blender's) if the render fails.
+    the scene's.  Raises RuntimeError (Blender's) if the render fails, and
+    :class:`.interrupt.Interrupted` if a stop was requested before or during
+    it (an MC Engine render then stops within a tenth of a second).
     """
     import bpy
 
-    from mcengine.imageio import read_exr
+    from mcengine.imageio import ImageError, read_exr
     bl_engine = ENGINES.get(engine.lower(), engine.upper())
-    if bl_engine == ENGINES["mcengine"]:
+    ours = bl_engine == ENGINES["mcengine"]
+    if ours:
         ensure_registered()
+        from ..engine import last_render
+        last_render.clear()   # what is left in it afterwards is this render's
     apply_overrides(scene, engine=bl_engine, samples=samples, seed=seed, resolution=resolution)
     set_image_format(scene, "OPEN_EXR")
+    interrupt.check()
     fd, tmp = tempfile.mkstemp(suffix=".exr", prefix="mcengine_")
     os.close(fd)
     try:
@@ -106,10 +114,16 @@ def render_scene(scene, engine: str, *, samples=None, seed=None, resolution=None
         t0 = time.perf_counter()
         bpy.ops.render.render(write_still=True, scene=scene.name)
         seconds = time.perf_counter() - t0
+        interrupt.check()     # an interrupted render is incomplete: not returned
         if os.path.getsize(tmp) == 0:
             raise RuntimeError(f"{bl_engine} wrote no image")
-        image = read_exr(tmp)
+        try:
+            image = read_exr(tmp)
+        except ImageError as exc:     # e.g. the temporary folder's disk is full
+            raise RuntimeError(f"{bl_engine}'s image could not be read back: {exc}") from None
     finally:
         Path(tmp).unlink(missing_ok=True)
+    stats = last_render.get("stats") if ours else None
     return Render(image=image, seconds=seconds, engine=bl_engine,
-                  samples=scene.cycles.samples, seed=scene.cycles.seed)
+                  samples=scene.cycles.samples, seed=scene.cycles.seed,
+                  nonfinite=int(getattr(stats, "nonfinite", 0) or 0))

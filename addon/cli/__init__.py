@@ -30,10 +30,24 @@ Conventions
 -----------
 * Every argument, the input file (its magic bytes) and the output folders are
   checked before ``bpy`` is imported, so bad input fails in well under a second.
+  What needs the loaded file (an unknown ``-S`` scene; an output whose ``#``
+  frame digits make it a folder or the scene file) is found after loading,
+  before rendering, with the same exit status 2.
 * Failures are one line on stderr, ``mcengine: error: ...``, never a traceback.
-  Exit status: 0 rendered, 1 the render (or file loading) failed, 2 bad input;
+  Exit status: 0 rendered, 1 the render (or file loading, or saving) failed,
+  2 bad input, 130 interrupted (SIGINT, Ctrl-C), 143 terminated (SIGTERM);
   ``compare`` exits 0 when the engines agree and 3 when they differ (1 and 2 as
   above; in a suite, any failed scene gives 1, else any difference 3).
+* Outputs are atomic (``batch.outputs``): written to a temporary file in the
+  target's folder, read back and checked, then renamed over the target, all
+  outputs of a command together.  A failed or interrupted command leaves what
+  was there; an output that is the scene file itself is refused (exit 2).
+* SIGINT and SIGTERM only set a flag (``signals``, ``batch.interrupt``): the
+  command stops at the next safe point, an MC Engine render within a tenth of
+  a second; what cannot stop in order within half a second (a Cycles render,
+  Blender loading) is ended by the command itself after removing its
+  temporary files.  Temporary files live in a folder of the command's own in
+  ``$TMPDIR``, Blender's included, removed at exit.
 * Output paths follow Blender: ``//`` is the .blend file's folder, the last run
   of ``#`` in the file name becomes the zero-padded frame number, and the
   format's extension is appended when the name has none.  ``-o`` may be given
@@ -61,6 +75,7 @@ Layout
 * ``args``: the parser, the validators and the requests they produce (no bpy);
 * ``console``: Blender's log captured, the progress display;
 * ``commands``: what ``render``, ``compare`` and ``study`` do (bpy from here on);
+* ``signals``: SIGINT and SIGTERM, the temporary folder, ending early and cleanly;
 * ``errors``: the program name, the exit statuses and the one-line error;
 * ``main`` (here) ties them together; ``python -m mcengine_blender.cli`` and
   the ``mcengine`` console script both call it.
@@ -70,35 +85,57 @@ from __future__ import annotations
 import sys
 import traceback
 
-from .args import CompareRequest, StudyRequest, parse_args
-from .commands import run_compare, run_render, run_study
-from .errors import EXIT_INTERRUPTED, EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
+# Only light modules here: main installs the signal handlers before numpy,
+# bpy or numba are imported (by .args and .commands).
+from ..batch.interrupt import Interrupted, requested
+from . import signals
+from .errors import EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
 
 __all__ = ["main"]
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Console entry point; returns the exit status."""
-    argv = sys.argv[1:] if argv is None else argv
+    """Console entry point; returns the exit status.
+
+    Without ``argv`` (the ``mcengine`` process itself) the signal handlers stay
+    installed until the process exits; with it (a caller in Python) the
+    previous handlers are put back.
+    """
+    with signals.handling(restore=argv is not None):
+        argv = sys.argv[1:] if argv is None else argv
+        return _run(argv)
+
+
+def _run(argv: list[str]) -> int:
     verbose = "--verbose" in argv
     try:
+        from .args import CompareRequest, StudyRequest, parse_args
         request = parse_args(argv)
         if request is None:
             return EXIT_OK
+        from .commands import run_compare, run_render, run_study
         if isinstance(request, CompareRequest):
             return run_compare(request)
         if isinstance(request, StudyRequest):
             return run_study(request)
         return run_render(request)
+    except Interrupted as exc:
+        return _interrupted(exc.signum)
     except CliError as exc:
+        if requested() is not None:     # the failure came from stopping
+            return _interrupted(requested())
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
     except Exception as exc:  # last resort: still one line unless asked for details
+        if requested() is not None:
+            return _interrupted(requested())
         if verbose:
             traceback.print_exc()
         print(f"{PROG}: error: internal error: {type(exc).__name__}: {exc} "
               "(run with --verbose for the traceback)", file=sys.stderr)
         return EXIT_RENDER_FAILED
+
+
+def _interrupted(signum: int) -> int:
+    signals.announce(signum)
+    return signals.exit_status(signum)

@@ -30,8 +30,8 @@ from ..batch.render import ENGINES
 from .errors import PROG, CliError
 
 __all__ = ["RenderRequest", "CompareRequest", "StudyRequest", "Output", "parse_args",
-           "build_parser", "check_blend_file", "check_output_folder", "prepare_output_folder",
-           "frame_path"]
+           "build_parser", "check_blend_file", "check_output_folder", "check_output_paths",
+           "check_folder_creatable", "frame_path", "partial_path"]
 
 DEFAULT_ENGINE = ENGINES["mcengine"]
 
@@ -247,6 +247,9 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("-t", "--threads", type=_threads, default=None,
                         help="CPU threads, 0 = all (default: the file's setting)")
     _add_integrator_options(render)
+    render.add_argument("--keep-partial", action="store_true",
+                        help="if the render is interrupted (Ctrl-C, SIGTERM), save the image so far "
+                             "as NAME.partial.exr/.png next to each output (MC Engine only)")
     render.add_argument("--verbose", action="store_true",
                         help="show Blender's own log and tracebacks")
     _add_compare_parser(commands)
@@ -413,6 +416,7 @@ class RenderRequest:
     integrator: str | None = None
     depth: int | None = None
     branching: int | None = None
+    keep_partial: bool = False
 
 
 def check_blend_file(path: Path) -> None:
@@ -473,7 +477,10 @@ def _output_for(raw: str, forced_format: str | None, blend_dir: Path) -> Output:
 
 
 def check_output_folder(path: Path) -> None:
-    """Raise CliError unless an image can be created at ``path`` (tested by writing)."""
+    """Raise CliError unless an image can be created at ``path`` (tested by writing).
+
+    A symbolic link is followed: the file it points to is the one replaced.
+    """
     folder = path.parent
     if not folder.exists():
         raise CliError(f"output folder does not exist: {folder}")
@@ -481,11 +488,48 @@ def check_output_folder(path: Path) -> None:
         raise CliError(f"output folder is not a folder: {folder}")
     if path.is_dir():
         raise CliError(f"output path is a folder: {path}")
+    real = Path(os.path.realpath(path))
+    for where in dict.fromkeys((folder, real.parent)):
+        if not where.is_dir():
+            raise CliError(f"output {path} is a link into a missing folder: {real}")
+        try:
+            with tempfile.TemporaryFile(dir=where):
+                pass
+        except OSError as exc:
+            raise CliError(f"cannot write to output folder {where}: {_os_reason(exc)}") from None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Same real path (symbolic links followed) or same inode (hard links)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
     try:
-        with tempfile.TemporaryFile(dir=folder):
-            pass
-    except OSError as exc:
-        raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_output_paths(paths, blendfile: Path) -> None:
+    """Raise CliError (exit 2) for output paths that must not be written.
+
+    ``paths`` are final (frame digits substituted): none may be a folder,
+    name the scene file itself (through a symbolic or hard link too), or be
+    given twice.
+    """
+    seen = {}
+    for path in paths:
+        if path.is_dir():
+            raise CliError(f"output path is a folder: {path}")
+        if _same_file(path, blendfile):
+            what = ("the scene file" if os.path.abspath(path) == os.path.abspath(blendfile)
+                    else f"the scene file {blendfile} under another name (a link)")
+            raise CliError(f"output {path} is {what}; rendering would overwrite the scene "
+                           "(choose another -o)")
+        real = os.path.realpath(path)
+        if real in seen:
+            raise CliError(f"output {path} is given twice" + (
+                f" (as {seen[real]})" if str(seen[real]) != str(path) else ""))
+        seen[real] = path
 
 
 @dataclass(frozen=True)
@@ -505,13 +549,21 @@ class CompareRequest:
     verbose: bool
 
 
-def prepare_output_folder(folder: Path) -> None:
-    """Create ``folder`` (and its parents) if needed; raise CliError unless it is writable."""
+def check_folder_creatable(folder: Path) -> None:
+    """Raise CliError unless ``folder`` exists and is writable, or can be created.
+
+    Nothing is created here: the folder is made when the results are written,
+    so a command that fails or is interrupted before leaves no empty folder.
+    """
     if folder.exists() and not folder.is_dir():
         raise CliError(f"output path is not a folder: {folder}")
+    existing = folder
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise CliError(f"cannot create output folder {folder}: {existing} is not a folder")
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
+        with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as exc:
         raise CliError(f"cannot write to output folder {folder}: {_os_reason(exc)}") from None
@@ -539,12 +591,12 @@ def _compare_request(args) -> CompareRequest:
         blendfile = Path(args.blendfile).absolute()
         check_blend_file(blendfile)
         default_out = f"compare-{blendfile.stem}"
-    out = Path(args.out if args.out is not None else default_out).absolute()
-    prepare_output_folder(out)
     kind, value = args.resolution if args.resolution is not None else (None, None)
     if kind == "size" and min(value) < MIN_COMPARE_SIZE:
         raise CliError(f"resolution {value[0]}x{value[1]} is too small for the comparison's "
                        f"{MIN_COMPARE_SIZE}x{MIN_COMPARE_SIZE} block grid")
+    out = Path(args.out if args.out is not None else default_out).absolute()
+    check_folder_creatable(out)
     return CompareRequest(
         blendfile=blendfile, suite=suite, out=out, samples=args.samples,
         resolution=value if kind == "size" else None,
@@ -582,7 +634,7 @@ def _study_request(args) -> StudyRequest:
                        f"errors against: use at least {max(2 * args.max_samples, REFERENCE_RENDERS)} "
                        f"(twice --max-samples), ideally 16 times")
     out = Path(args.out if args.out is not None else f"study-{blendfile.stem}").absolute()
-    prepare_output_folder(out)
+    check_folder_creatable(out)
     return StudyRequest(
         blendfile=blendfile, out=out, max_samples=args.max_samples,
         integrators=args.integrators, with_cycles=args.with_cycles, seeds=args.seeds,
@@ -611,17 +663,30 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest
     engine = args.engine or DEFAULT_ENGINE
     _check_integrator_options((args.integrator,) if args.integrator else (), args.depth,
                               args.branching, engine)
+    if args.keep_partial and engine != DEFAULT_ENGINE:
+        raise CliError("--keep-partial applies to MC Engine renders only (a Cycles render "
+                       "cannot be stopped part-way from Python)")
     blendfile = Path(args.blendfile).absolute()
     check_blend_file(blendfile)
     raw_outputs = args.outputs or [f"{blendfile.stem}{FORMATS[args.format or DEFAULT_FORMAT]}"]
     outputs = tuple(_output_for(raw, args.format, blendfile.parent) for raw in raw_outputs)
     for output in outputs:
         check_output_folder(output.pattern)
+    # The frame is known now if it was given or no name has '#'; otherwise the
+    # same check runs once the file is loaded (commands.run_render).
+    if args.frame is not None or not any("#" in o.pattern.name for o in outputs):
+        check_output_paths([frame_path(o.pattern, args.frame or 0) for o in outputs], blendfile)
     return RenderRequest(
         blendfile=blendfile, engine=engine, outputs=outputs,
         samples=args.samples, resolution=args.resolution, seed=args.seed, frame=args.frame,
         scene=args.scene, threads=args.threads, verbose=args.verbose,
-        integrator=args.integrator, depth=args.depth, branching=args.branching)
+        integrator=args.integrator, depth=args.depth, branching=args.branching,
+        keep_partial=args.keep_partial)
+
+
+def partial_path(path: Path) -> Path:
+    """Where ``--keep-partial`` saves an interrupted render: ``shot.exr`` -> ``shot.partial.exr``."""
+    return path.with_name(f"{path.stem}.partial{path.suffix}")
 
 
 def frame_path(pattern: Path, frame: int) -> Path:

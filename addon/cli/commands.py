@@ -9,10 +9,11 @@ themselves are the add-on's batch tools (:mod:`..batch`); the files come from
 """
 from __future__ import annotations
 
-import contextlib
 import time
 from pathlib import Path
 
+from ..batch import interrupt
+from ..batch.outputs import OutputError, Staging, verify, write_folder
 from ..batch.render import (
     ENGINES,
     NoSuchScene,
@@ -23,7 +24,8 @@ from ..batch.render import (
     render_scene,
 )
 from ..batch.settings import apply_overrides, set_image_format
-from .args import CompareRequest, RenderRequest, StudyRequest, frame_path
+from . import signals
+from .args import CompareRequest, RenderRequest, StudyRequest, check_output_paths, frame_path, partial_path
 from .console import BlenderLog, Progress, engine_traceback, warning_lines
 from .errors import EXIT_DIFFER, EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
 
@@ -44,12 +46,25 @@ def _import_bpy():
 
 
 def _register_addon() -> None:
-    """Register MC Engine (only done when it is the engine asked for)."""
+    """Register MC Engine (only done when it is the engine asked for); its renders stop
+    when the command is interrupted."""
     try:
         ensure_registered()
+        interrupt.install_engine_hook()
     except Exception as exc:  # the add-on's failure must not hide behind a traceback
         raise CliError(f"the MC Engine add-on failed to register: {type(exc).__name__}: {exc}",
                        EXIT_RENDER_FAILED) from None
+
+
+def _start_blender(register: bool):
+    """Import bpy (and register MC Engine); a stop requested meanwhile is honoured here."""
+    interrupt.check()
+    bpy = _import_bpy()
+    signals.note_temporary_folder(bpy.app.tempdir)   # removed if the process must end early
+    interrupt.check()
+    if register:
+        _register_addon()  # before loading, as an enabled add-on would be
+    return bpy
 
 
 class _LoggedRenderer:
@@ -107,42 +122,84 @@ def _open(path: Path, scene_name: str | None):
         raise CliError(str(exc), EXIT_RENDER_FAILED) from None
 
 
-def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderLog) -> None:
-    """Render once, save every output, raise CliError on any failure."""
-    first, *others = zip(request.outputs, paths)
-    set_image_format(scene, first[0].file_format)
-    scene.render.filepath = str(first[1])
-    scene.render.use_file_extension = True
+def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderLog) -> int:
+    """Render once and save every output; returns the samples per pixel rendered.
+
+    Raises CliError on any failure and Interrupted if the command was stopped;
+    in both cases no output is touched (with ``--keep-partial``, an
+    interrupted MC Engine render is saved under the partial names).
+    """
+    ours = request.engine == ENGINES["mcengine"]
+    if ours:
+        from ..engine import last_render
+        last_render.clear()   # what is left in it afterwards is this render's
     progress = Progress(log.console, request.engine)
     log_start = log.mark()
+    interrupt.check()
     bpy.app.handlers.render_stats.append(progress.on_stats)
     try:
         with log.capture():
-            bpy.ops.render.render(write_still=True, scene=scene.name)
+            bpy.ops.render.render(write_still=False, scene=scene.name)
     except RuntimeError as exc:
+        interrupt.check()
         raise CliError(f"render failed: {error_message(exc)}", EXIT_RENDER_FAILED) from None
     finally:
         bpy.app.handlers.render_stats.remove(progress.on_stats)
         progress.finish()
     crash = engine_traceback(log.text(since=log_start))
     if crash is not None:
-        _remove_quietly(first[1])
+        interrupt.check()
         raise CliError(f"render failed: {request.engine} raised {crash}", EXIT_RENDER_FAILED)
-    if not first[1].is_file():
-        raise CliError(f"render finished but no image was written to {first[1]}", EXIT_RENDER_FAILED)
+    if interrupt.requested() is not None:
+        if request.keep_partial and ours:
+            partials = [partial_path(path) for path in paths]
+            _save(bpy, scene, request.outputs, partials, log)
+            log.console.write(f"{PROG}: kept the partial image ({_samples_done(ours, progress)} "
+                              f"samples) in {', '.join(map(str, partials))}\n")
+        interrupt.check()
+    _save(bpy, scene, request.outputs, paths, log)
+    return _samples_done(ours, progress)
+
+
+def _samples_done(ours: bool, progress: Progress) -> int | None:
+    """Samples per pixel the last render took (a time limit or a stop ends it early)."""
+    if ours:
+        from ..engine import last_render
+        stats = last_render.get("stats")
+        if stats is not None and getattr(stats, "samples_done", None) is not None:
+            return int(stats.samples_done)
+    return progress.done
+
+
+def _save(bpy, scene, outputs, paths: list[Path], log: BlenderLog) -> None:
+    """Save the Render Result to every path: temporary files next to the targets,
+    read back, then renamed over the targets together (batch.outputs)."""
     result = bpy.data.images["Render Result"]
-    for output, path in others:
-        set_image_format(scene, output.file_format)
+    with Staging() as staging:
+        for output, path in zip(outputs, paths):
+            try:
+                temp = staging.temp(path)
+            except OutputError as exc:
+                raise CliError(f"cannot save {path}: {exc}", EXIT_RENDER_FAILED) from None
+            try:
+                set_image_format(scene, output.file_format)
+                with log.capture():   # OpenEXR prints its complaints about a bad file
+                    result.save_render(filepath=str(temp), scene=scene)
+                    verify(temp, output.file_format)
+            except RuntimeError as exc:
+                raise CliError(f"cannot save {path}: {error_message(exc)}{_unchanged(path)}",
+                               EXIT_RENDER_FAILED) from None
+            except OutputError as exc:
+                raise CliError(f"cannot save {path}: Blender wrote {exc} (is the disk full?)"
+                               f"{_unchanged(path)}", EXIT_RENDER_FAILED) from None
         try:
-            with log.capture():
-                result.save_render(filepath=str(path), scene=scene)
-        except RuntimeError as exc:
-            raise CliError(f"cannot save {path}: {error_message(exc)}", EXIT_RENDER_FAILED) from None
+            staging.commit()
+        except OutputError as exc:
+            raise CliError(str(exc), EXIT_RENDER_FAILED) from None
 
 
-def _remove_quietly(path: Path) -> None:
-    with contextlib.suppress(OSError):
-        path.unlink()
+def _unchanged(path: Path) -> str:
+    return "; the existing file is unchanged" if path.exists() else ""
 
 
 def _ray_accounting() -> str | None:
@@ -157,25 +214,33 @@ def run_render(request: RenderRequest) -> int:
     started = time.monotonic()
     ours = request.engine == ENGINES["mcengine"]
     with log.capture():
-        bpy = _import_bpy()
-        if ours:
-            _register_addon()  # before loading, as an enabled add-on would be
+        bpy = _start_blender(register=ours)
         scene = _open(request.blendfile, request.scene)
+        interrupt.check()
         apply_overrides(scene, engine=request.engine, samples=request.samples, seed=request.seed,
                         resolution=request.resolution, threads=request.threads,
                         frame=request.frame, integrator=request.integrator,
                         depth=request.depth, branching=request.branching)
     frame = scene.frame_current
     paths = [frame_path(output.pattern, frame) for output in request.outputs]
-    _render(bpy, scene, request, paths, log)
+    # Again now that the frame is known ('#' in a name), before anything is rendered.
+    check_output_paths(paths, request.blendfile)
+    if request.keep_partial:
+        check_output_paths([partial_path(path) for path in paths], request.blendfile)
+    samples = _render(bpy, scene, request, paths, log)
     for warning in warning_lines(log.text()):
         log.console.write(f"{PROG}: warning: {warning}\n")
     render = scene.render
     scale = render.resolution_percentage / 100
+    asked = scene.cycles.samples
+    if samples is None or samples == asked:
+        samples_text = f"{asked} samples"
+    else:
+        samples_text = f"{samples} of {asked} samples"
     log.console.write(
         f"{PROG}: rendered {scene.name!r} frame {frame} with {request.engine}, "
         f"{round(render.resolution_x * scale)}x{round(render.resolution_y * scale)}, "
-        f"{scene.cycles.samples} samples, in {time.monotonic() - started:.1f} s\n")
+        f"{samples_text}, in {time.monotonic() - started:.1f} s\n")
     if ours:
         accounting = _ray_accounting()
         if accounting:
@@ -193,8 +258,7 @@ def run_compare(request: CompareRequest) -> int:
     """Compare one file or a suite; returns the exit status (0 agree, 3 differ)."""
     log = BlenderLog(passthrough=request.verbose)
     with log.capture():
-        bpy = _import_bpy()
-        _register_addon()
+        bpy = _start_blender(register=True)
     from mcengine.evaluation.output import write_comparison
 
     from ..batch.comparison import CompareError, CompareOptions, compare_file, run_suite
@@ -227,8 +291,9 @@ def run_compare(request: CompareRequest) -> int:
         with log.capture():
             comparison = compare_file(request.blendfile, options, scene_name=request.scene,
                                       render=renderer, on_render=renderer.on_render)
-            paths = write_comparison(comparison, request.out)
-    except CompareError as exc:
+            interrupt.check()
+            paths = write_folder(write_comparison, comparison, request.out)
+    except (CompareError, OutputError) as exc:
         raise CliError(str(exc), EXIT_RENDER_FAILED) from None
     for warning in renderer.warnings:
         console.write(f"{PROG}: warning: {warning}\n")
@@ -247,8 +312,7 @@ def run_study(request: StudyRequest) -> int:
     """Render the study and write its files; returns the exit status."""
     log = BlenderLog(passthrough=request.verbose)
     with log.capture():
-        bpy = _import_bpy()
-        _register_addon()
+        bpy = _start_blender(register=True)
     from mcengine.evaluation.output import write_study
     from mcengine.evaluation.study import StudyError, StudyOptions, summarise
 
@@ -271,8 +335,9 @@ def run_study(request: StudyRequest) -> int:
         with log.capture():
             study = study_file(request.blendfile, options, settings, scene_name=request.scene,
                                render=renderer, on_render=on_render)
-            paths = write_study(study, request.out)
-    except (StudyError, RuntimeError) as exc:
+            interrupt.check()
+            paths = write_folder(write_study, study, request.out)
+    except (StudyError, RuntimeError, OutputError) as exc:
         raise CliError(str(exc).splitlines()[0], EXIT_RENDER_FAILED) from None
     for warning in renderer.warnings:
         console.write(f"{PROG}: warning: {warning}\n")

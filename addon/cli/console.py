@@ -106,6 +106,7 @@ class Progress:
         self.start = time.monotonic()
         self._lines_printed = 0  # non-TTY: number of PROGRESS_LINE_STEP steps reported
         self._drawn = False
+        self.done: int | None = None   # the last sample count reported ("Sample N/M")
 
     def on_stats(self, stats, *_unused) -> None:
         """``bpy.app.handlers.render_stats`` callback; never raises."""
@@ -120,6 +121,7 @@ class Progress:
                 self._draw(f"{self.label}: {phase}")
             return
         done, total = int(match[1]), int(match[2])
+        self.done = done
         fraction = min(done / total, 1.0) if total else 0.0
         if self.is_tty:
             filled = round(fraction * PROGRESS_BAR_WIDTH)

@@ -6,7 +6,7 @@ line, ``mcengine: error: ...``, with the error's exit status.
 from __future__ import annotations
 
 __all__ = ["PROG", "EXIT_OK", "EXIT_RENDER_FAILED", "EXIT_BAD_INPUT", "EXIT_DIFFER",
-           "EXIT_INTERRUPTED", "CliError"]
+           "EXIT_INTERRUPTED", "EXIT_TERMINATED", "CliError"]
 
 PROG = "mcengine"
 
@@ -14,7 +14,8 @@ EXIT_OK = 0
 EXIT_RENDER_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_DIFFER = 3
-EXIT_INTERRUPTED = 130
+EXIT_INTERRUPTED = 130      # SIGINT (Ctrl-C): 128 + 2, as shells report it
+EXIT_TERMINATED = 143       # SIGTERM: 128 + 15
 
 
 class CliError(Exception):

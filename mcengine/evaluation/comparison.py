@@ -66,6 +66,7 @@ class EngineRuns:
     samples  samples per pixel of each render
     seeds    (K,) the seeds used
     notes    lines for the report, e.g. features the engine did not support
+    nonfinite  samples the engine dropped as NaN or infinite, over the K renders
     """
 
     images: np.ndarray
@@ -73,6 +74,7 @@ class EngineRuns:
     samples: int
     seeds: list
     notes: list = field(default_factory=list)
+    nonfinite: int = 0
 
     @property
     def mean_image(self) -> np.ndarray:
@@ -235,6 +237,9 @@ def build_comparison(scene: str, ours: EngineRuns, cycles: EngineRuns, *, grid=(
     """
     agreement = compare_stacks(ours.images, cycles.images, grid=grid, alpha=alpha)
     notes = [*ours.notes, *cycles.notes, *notes]
+    if ours.nonfinite:
+        notes.append(f"{OURS_LABEL} dropped {ours.nonfinite:,} non-finite samples (NaN or "
+                     f"infinite) over its {len(ours.seeds)} renders; its image leaves them out.")
     if agreement.pixels_correlated:
         notes.append("Neighbouring pixels of one engine are correlated (a denoiser or a "
                      "splatting pixel filter?); the test widened its variances to match.")
@@ -290,6 +295,9 @@ def build_comparison(scene: str, ours: EngineRuns, cycles: EngineRuns, *, grid=(
         "notes": notes,
         "agreement": agreement.to_dict(),
     }
+    if ours.nonfinite:
+        # Only when there are any: samples MC Engine dropped, summed over its K renders.
+        report["nonfinite_samples"] = int(ours.nonfinite)
     return Comparison(scene=scene, ours=ours, cycles=cycles, agreement=agreement,
                       report=report, notes=notes)
 
@@ -319,6 +327,7 @@ class SuiteRow:
     samples: str = ""
     wall_seconds: float | None = None   # the whole scene: loading, 2K renders, report
     error: str = ""
+    nonfinite: int = 0      # samples MC Engine dropped as NaN or infinite (K renders)
 
     def to_dict(self) -> dict:
         return dict(self.__dict__)
@@ -338,7 +347,8 @@ def suite_row(c: Comparison, folder: str) -> SuiteRow:
         detectable_bias=max(detectable) if detectable else None,
         blocks_differ=f"{r['blocks']['differ']}/{r['blocks']['tested']}",
         resolution=f"{w}x{h}",
-        samples=f"{spp['mcengine']} x {len(c.ours.seeds)}")
+        samples=f"{spp['mcengine']} x {len(c.ours.seeds)}",
+        nonfinite=int(r.get("nonfinite_samples", 0)))
 
 
 def suite_verdict(rows) -> str:

@@ -92,6 +92,8 @@ def report_markdown(c: Comparison) -> str:
                   for e in ("mcengine", "cycles")) + " |",
               "| mean render time (s) | " + " | ".join(
                   f"{r['times'][e]['mean']:.2f}" for e in ("mcengine", "cycles")) + " |"]
+    if r.get("nonfinite_samples"):
+        lines.append(f"| non-finite samples dropped (all renders) | {r['nonfinite_samples']:,} | |")
     for key, value in s.items():
         if key not in ("resolution", "samples", "seeds"):
             lines.append(f"| {key.replace('_', ' ')} | {value} | {value} |")
@@ -181,10 +183,12 @@ def _settings_line(rows) -> str:
     done = [r for r in rows if r.verdict != "error"]
     res = sorted({r.resolution for r in done})
     spp = sorted({r.samples for r in done})
+    dropped = [f"{r.scene} ({r.nonfinite:,})" for r in done if getattr(r, "nonfinite", 0)]
     return (f"{len(rows)} scenes; resolution {', '.join(res) or 'n/a'}; samples x seeds per engine "
             f"{', '.join(spp) or 'n/a'}; {sum(r.verdict == 'agree' for r in rows)} agree, "
             f"{sum(r.verdict == 'differ' for r in rows)} differ, "
-            f"{sum(r.verdict == 'error' for r in rows)} failed.")
+            f"{sum(r.verdict == 'error' for r in rows)} failed."
+            + (f" MC Engine dropped non-finite samples in: {', '.join(dropped)}." if dropped else ""))
 
 
 def suite_markdown(rows, thumbnails: bool = True) -> str:

@@ -195,3 +195,58 @@ def test_suite_writes_one_summary_and_keeps_going_after_a_failure(scenes, tmp_pa
     assert "**differ**" in markdown and "**error**" in markdown
     assert '<img src="textured/thumbnail.png"' in page
     assert "1/3 scenes agree" in done.stderr
+
+
+# ---------------------------------------------------------------------------
+# Non-finite samples in the report
+# ---------------------------------------------------------------------------
+
+# The command, with every MC Engine render made to report 5 dropped samples
+# (the count the render session keeps in RenderStats.nonfinite).
+WITH_NONFINITE = textwrap.dedent("""
+    import sys
+    from mcengine import session
+    run = session.RenderSession.run
+    def run_dropping_five(self, *args, **kwargs):
+        result = run(self, *args, **kwargs)
+        self.stats.nonfinite += 5
+        return result
+    session.RenderSession.run = run_dropping_five
+    from mcengine_blender import cli
+    sys.exit(cli.main(sys.argv[1:]))
+""")
+
+
+def test_nonfinite_samples_are_reported_summed_over_the_renders(scenes, tmp_path):
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-c", WITH_NONFINITE, "compare", str(scenes / "plain.blend"),
+                           "--samples", "8", "--resolution", "16x16", "--seeds", "3", "--out", str(out)],
+                          capture_output=True, text=True, timeout=TIMEOUT, stdin=subprocess.DEVNULL)
+    assert done.returncode == EXIT_OK, done.stderr
+    report = json.loads((out / "report.json").read_text())
+    assert report["nonfinite_samples"] == 3 * 5
+    markdown = (out / "report.md").read_text()
+    assert "| non-finite samples dropped (all renders) | 15 | |" in markdown
+    assert "dropped 15 non-finite samples" in markdown
+
+
+def test_no_nonfinite_field_when_none_were_dropped():
+    import numpy as np
+
+    from mcengine.evaluation.comparison import EngineRuns, build_comparison, suite_row
+    from mcengine.evaluation.pages import report_markdown, suite_summary_markdown
+    rng = np.random.default_rng(1)
+
+    def runs(nonfinite):
+        return EngineRuns(images=rng.uniform(0.4, 0.6, (2, 16, 16, 4)).astype(np.float32),
+                          seconds=[1.0, 1.0], samples=8, seeds=[1, 2], nonfinite=nonfinite)
+
+    clean = build_comparison("clean", runs(0), runs(0))
+    assert "nonfinite_samples" not in clean.report
+    assert "non-finite" not in report_markdown(clean)
+    dropped = build_comparison("dropped", runs(1234), runs(0))
+    assert dropped.report["nonfinite_samples"] == 1234
+    assert "non-finite samples dropped (all renders) | 1,234 |" in report_markdown(dropped)
+    rows = [suite_row(clean, "clean"), suite_row(dropped, "dropped")]
+    assert [row.nonfinite for row in rows] == [0, 1234]
+    assert "MC Engine dropped non-finite samples in: dropped (1,234)." in suite_summary_markdown(rows)

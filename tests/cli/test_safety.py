@@ -146,6 +146,16 @@ def assert_one_line_error(done, exit_code: int, *fragments: str) -> None:
         assert fragment in own[0], done.stderr
 
 
+@pytest.fixture(scope="module")
+def warm_kernels(tmp_path_factory):
+    """One plain render first: compiling the kernels (a cold cache) writes cache files,
+    which a file-size limit must not get in the way of."""
+    folder = tmp_path_factory.mktemp("warm")
+    done = run_cli("render", LIGHT_POINT, "--resolution", "8x8", "--samples", "1",
+                   "-o", folder / "warm.exr", tmpdir=folder)
+    assert done.returncode == 0, done.stderr
+
+
 def file_size_limit(limit: int):
     """preexec_fn: files may not grow past ``limit`` bytes; write() then fails with EFBIG
     (SIGXFSZ, which would kill the process, is ignored), as on a full disk."""
@@ -163,7 +173,7 @@ def file_size_limit(limit: int):
     ("shot.exr", 8000),     # the 64x64 float EXR is ~50 kB, its PNG ~12 kB
     ("shot.png", 4000),
 ])
-def test_failed_write_keeps_the_previous_image(name, limit, out_dir, tmpdir_env):
+def test_failed_write_keeps_the_previous_image(name, limit, out_dir, tmpdir_env, warm_kernels):
     target = out_dir / name
     target.write_bytes(PREVIOUS)
     done = run_cli("render", LIGHT_POINT, "--resolution", "64x64", "--samples", "4",
@@ -173,7 +183,7 @@ def test_failed_write_keeps_the_previous_image(name, limit, out_dir, tmpdir_env)
     assert_nothing_left(out_dir, tmpdir_env, {name})
 
 
-def test_second_output_failing_keeps_both_previous_images(out_dir, tmpdir_env):
+def test_second_output_failing_keeps_both_previous_images(out_dir, tmpdir_env, warm_kernels):
     """The outputs of one render are replaced together or not at all."""
     png, exr = out_dir / "shot.png", out_dir / "shot.exr"
     png.write_bytes(PREVIOUS)
@@ -361,7 +371,7 @@ def test_compare_does_not_create_its_folder_before_failing(tmp_path, tmpdir_env)
     assert not (tmp_path / "new").exists()
 
 
-def test_compare_that_cannot_write_keeps_the_previous_report(out_dir, tmpdir_env):
+def test_compare_that_cannot_write_keeps_the_previous_report(out_dir, tmpdir_env, warm_kernels):
     """The renders fit in the file-size limit, side_by_side.png does not: nothing is replaced."""
     previous_report(out_dir)
     done = run_cli("compare", LIGHT_POINT, "--resolution", "16x16", "--samples", "8",

@@ -13,12 +13,19 @@ scene's working space (Linear Rec.709), angles in radians.  Cameras and lights
 are aimed with :func:`look_at`, which points the object's local -Z axis (the
 direction cameras look and area, spot and sun lights shine) at a target.
 
-Materials are restricted to what both engines treat identically:
+Materials of the light, camera and transform scenes are restricted to the
+simplest closures, so that those scenes test lights and geometry only:
 
 * :func:`diffuse_material`: Diffuse BSDF with roughness 0 (Lambert).
 * :func:`lambert_principled_material`: Principled BSDF with 'Specular IOR
   Level' 0, which is exactly Lambert too (it exercises the Principled path).
 * :func:`emission_material`: Emission shader, radiance = colour x strength.
+
+The material scenes (``material_*.py``) build any shader node with
+:func:`node_material` (one node into the Surface output) and
+:func:`combine_material` (a Mix or Add Shader of two nodes); inputs are named
+in snake case (``base_color=``, ``specular_ior_level=``) and anything that is
+not an input is a node property (``distribution="GGX"``).
 
 Determinism: the same script writes the same bytes.  :func:`save_blend` lets
 Blender write the file uncompressed, rewrites the few fields Blender fills from
@@ -186,6 +193,82 @@ def emission_material(name, color, strength):
     return material
 
 
+def _find_input(node, key):
+    """The enabled input socket of ``node`` called ``key``: its identifier, its name, or
+    either spelled in snake case ('base_color' for 'Base Color'); None if there is none."""
+    spaced = key.replace("_", " ").lower()
+    enabled = [socket for socket in node.inputs if socket.enabled]
+    for socket in enabled:
+        if key in (socket.identifier, socket.name):
+            return socket
+    for socket in enabled:
+        if spaced in (socket.identifier.lower(), socket.name.lower()):
+            return socket
+    return None
+
+
+def set_node_values(node, **values):
+    """Set inputs of a shader node by name (see :func:`_find_input`); a key that names no
+    input is a node property (``distribution="GGX"``).  RGB tuples get alpha 1."""
+    for key, value in values.items():
+        socket = _find_input(node, key)
+        if socket is None:
+            if not hasattr(node, key):
+                raise KeyError(f"{node.bl_idname} has no input or property {key!r}")
+            setattr(node, key, value)
+        elif isinstance(value, (tuple, list)) and len(value) == 3 \
+                and len(socket.default_value) == 4:
+            socket.default_value = (*value, 1.0)
+        else:
+            socket.default_value = value
+    return node
+
+
+def shader_node(tree, bl_idname, location=(0.0, 0.0), **values):
+    """Add a node of type ``bl_idname`` to ``tree`` with the given input values."""
+    node = tree.nodes.new(bl_idname)
+    node.location = location
+    return set_node_values(node, **values)
+
+
+def _viewport_color(material, values):
+    color = values.get("base_color", values.get("color"))
+    if isinstance(color, (tuple, list)) and len(color) == 3:
+        material.diffuse_color = (*color, 1.0)  # viewport colour only
+
+
+def node_material(name, bl_idname, **values):
+    """One shader node (e.g. 'ShaderNodeBsdfGlass') into the Surface output.
+
+    ``values`` are its inputs in snake case and its properties, e.g.
+    ``node_material("Metal", "ShaderNodeBsdfPrincipled", base_color=(1, .78, .34),
+    metallic=1.0, roughness=0.3, distribution="GGX")``.  Inputs not given keep
+    Blender's defaults.
+    """
+    material, tree, output = _new_material(name)
+    node = shader_node(tree, bl_idname, **values)
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    _viewport_color(material, values)
+    return material
+
+
+def combine_material(name, first, second, fac=None):
+    """A Mix Shader (``fac`` given: 0 is ``first``, 1 is ``second``) or an Add Shader
+    (``fac`` None) of two shader nodes, each given as ``(bl_idname, {input: value})``."""
+    material, tree, output = _new_material(name)
+    nodes = [shader_node(tree, kind, location=(-300.0, 150.0 - 300.0 * i), **values)
+             for i, (kind, values) in enumerate((first, second))]
+    if fac is None:
+        combine = shader_node(tree, "ShaderNodeAddShader")
+    else:
+        combine = shader_node(tree, "ShaderNodeMixShader", fac=fac)
+    tree.links.new(nodes[0].outputs[0], combine.inputs["Shader"])
+    tree.links.new(nodes[1].outputs[0], combine.inputs["Shader_001"])
+    tree.links.new(combine.outputs[0], output.inputs["Surface"])
+    _viewport_color(material, first[1])
+    return material
+
+
 # --------------------------------------------------------------------------
 # Objects
 # --------------------------------------------------------------------------
@@ -285,6 +368,48 @@ def add_uv_sphere(scene, name, radius, material, smooth=True,
     return add_mesh(scene, name, vertices, faces, material, smooth=smooth, **transform)
 
 
+def add_cylinder(scene, name, radius, height, material, segments=SPHERE_SEGMENTS, **transform):
+    """Add a closed cylinder standing on the object origin (z = 0 .. height).
+
+    The side is smooth-shaded and the two caps are flat; the caps have their
+    own vertices, so the side's vertex normals stay horizontal (no averaging
+    with the caps) while the surface stays closed (the caps' rims lie exactly
+    on the side's).
+    """
+    ring = [(radius * math.cos(2.0 * math.pi * k / segments),
+             radius * math.sin(2.0 * math.pi * k / segments)) for k in range(segments)]
+    vertices = [(x, y, z) for z in (0.0, float(height)) for x, y in ring]  # side: 0..2n-1
+    vertices += [(x, y, z) for z in (0.0, float(height)) for x, y in ring]  # caps: 2n..4n-1
+    n = segments
+    side = [(k, (k + 1) % n, n + (k + 1) % n, n + k) for k in range(n)]
+    bottom = tuple(2 * n + k for k in reversed(range(n)))
+    top = tuple(3 * n + k for k in range(n))
+    obj = add_mesh(scene, name, vertices, side + [bottom, top], material, smooth=True, **transform)
+    mesh = obj.data
+    for face in mesh.polygons[n:]:
+        face.use_smooth = False
+    mesh.update()
+    return obj
+
+
+def add_suzanne(scene, name, material, subdivision_levels=2, **transform):
+    """Add Blender's monkey head (the data of ``bmesh.ops.create_monkey``, 2 m wide,
+    facing -Y) with a Subdivision Surface modifier and smooth shading."""
+    import bmesh
+
+    bm = bmesh.new()
+    bmesh.ops.create_monkey(bm)
+    vertices = [tuple(v.co) for v in bm.verts]
+    faces = [tuple(v.index for v in f.verts) for f in bm.faces]
+    bm.free()
+    obj = add_mesh(scene, name, vertices, faces, material, smooth=True, **transform)
+    if subdivision_levels:
+        modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+        modifier.levels = subdivision_levels
+        modifier.render_levels = subdivision_levels
+    return obj
+
+
 def add_empty(scene, name, parent=None, **transform):
     """Add an empty (a transform only), optionally parented; returns it.
 
@@ -359,6 +484,14 @@ STAGE_CAMERA_LOCATION = (0.0, -5.2, 4.4)
 STAGE_CAMERA_TARGET = (0.0, 0.2, 0.35)
 
 
+def add_floor(scene, material=None):
+    """The stage floor: a 24 m square quad at z = 0, grey Diffuse BSDF 0.6 by default."""
+    h = STAGE_FLOOR_HALF_SIZE
+    if material is None:
+        material = diffuse_material("Floor", (0.6, 0.6, 0.6))
+    return add_quad(scene, "Floor", [(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)], material)
+
+
 def add_stage(scene):
     """Floor, a rotated cube, a smooth sphere, a small box and the camera.
 
@@ -366,9 +499,7 @@ def add_stage(scene):
     fill the frame.  The cube uses the Lambert Principled material, the sphere
     and the small box use Diffuse BSDF.  Returns a dict of the objects.
     """
-    h = STAGE_FLOOR_HALF_SIZE
-    floor = add_quad(scene, "Floor", [(-h, -h, 0), (h, -h, 0), (h, h, 0), (-h, h, 0)],
-                     diffuse_material("Floor", (0.6, 0.6, 0.6)))
+    floor = add_floor(scene)
     cube = add_box(scene, "Cube", (1.0, 1.0, 1.0),
                    lambert_principled_material("Cube", (0.2, 0.35, 0.7)),
                    location=(-1.0, 0.4, 0.0), rotation=(0.0, 0.0, math.radians(30.0)))

@@ -31,6 +31,10 @@ SCENES = (
     "camera_sensor_fit",
     "camera_portrait_wide",
     "camera_ortho",
+    "material_principled",
+    "material_nodes",
+    "material_suzanne",
+    "material_rough_glass",
 )
 
 

@@ -17,7 +17,12 @@ For MC Engine it also prints the share of worker time spent inside Embree,
 rays per path, and the peak resident memory of the process (Blender included)
 and of the renderer's own buffers.
 
+With ``--materials principled`` every surface is the default Principled BSDF
+(roughness 0.5, Specular IOR Level 0.5, Multiscatter GGX) of its base colour,
+the material a Blender user starts from.
+
 Run: python benchmarks/bench_cornell.py [--samples N] [--resolution N] [--rounds R]
+                                        [--materials file|principled]
 """
 from __future__ import annotations
 
@@ -36,6 +41,9 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=128)
     ap.add_argument("--resolution", type=int, default=256)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--materials", choices=("file", "principled"), default="file",
+                    help="the file's Lambert materials, or every surface the default Principled "
+                         "BSDF of the same base colour (the light keeps its emission)")
     args = ap.parse_args(argv)
 
     import bpy  # noqa: F401  (Blender as a module)
@@ -60,6 +68,8 @@ def main(argv=None) -> int:
     def run(bl_engine, samples):
         scene = open_scene(SCENE)
         make_unbiased(scene)
+        if args.materials == "principled":
+            to_default_principled(bpy)
         return render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
 
     # Warm-up: load numba's kernel cache and Cycles' kernels once.
@@ -85,8 +95,8 @@ def main(argv=None) -> int:
     session = sessions[-1]
     buffers = session.buffer_bytes
     print()
-    print(f"Cornell box {args.resolution}x{args.resolution}, {args.samples} spp, 8 bounces, "
-          f"medians of {args.rounds} rounds")
+    print(f"Cornell box ({args.materials} materials) {args.resolution}x{args.resolution}, "
+          f"{args.samples} spp, 8 bounces, medians of {args.rounds} rounds")
     print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}")
     for e in ("MCENGINE", "CYCLES"):
         print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}")
@@ -99,6 +109,25 @@ def main(argv=None) -> int:
     print(f"memory: renderer buffers {buffers / 2**20:.0f} MiB; process peak RSS "
           f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB (Blender included)")
     return 0
+
+
+def to_default_principled(bpy) -> None:
+    """Replace every Diffuse or Principled surface by a default Principled BSDF (roughness
+    0.5, specular 0.5, Multiscatter GGX) of the same base colour."""
+    for material in bpy.data.materials:
+        tree = material.node_tree
+        out = tree.get_output_node("CYCLES") if tree else None
+        if out is None or not out.inputs["Surface"].is_linked:
+            continue
+        shader = out.inputs["Surface"].links[0].from_node
+        color = {"ShaderNodeBsdfDiffuse": "Color", "ShaderNodeBsdfPrincipled": "Base Color"}.get(
+            shader.bl_idname)
+        if color is None:
+            continue
+        base = tuple(shader.inputs[color].default_value)
+        node = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        node.inputs["Base Color"].default_value = base
+        tree.links.new(node.outputs[0], out.inputs["Surface"])
 
 
 if __name__ == "__main__":

@@ -82,6 +82,7 @@ from .state import (
     CFG_LIGHTS,
     CFG_MAX_TRANSPARENT,
     FCFG_EMIT_SCALE,
+    MF_EMISSIVE,
     PF_TERMINATE,
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
@@ -192,6 +193,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
+        if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
+            continue   # a terminated path only collects emission, and there is none
         res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,

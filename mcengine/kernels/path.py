@@ -79,6 +79,7 @@ from .state import (
     CFG_MIN_LIGHT_BOUNCES,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
+    MF_EMISSIVE,
     PF_MIS_SKIP,
     PF_TERMINATE,
     PF_TRANSPARENT,
@@ -142,6 +143,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
+        if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
+            continue   # a terminated path only collects emission, and there is none
         res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
 
         # Holdout: the film's alpha drops by the holdout weight on camera paths.

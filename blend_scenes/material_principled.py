@@ -8,17 +8,20 @@ shadows and camera rays through a half-transparent surface) and the specular
 tint of a dielectric.
 
 A 3 x 3 grid of 64x32 smooth UV spheres of radius 0.42 on the stage floor,
-1.05 m apart, rows from the back (y = +1.05) to the front (y = -1.05), each a
-Principled BSDF with Blender's defaults except:
+1.05 m apart, seen from above at about 55 deg so that they fill the frame,
+rows from the back (y = +1.05) to the front (y = -1.05), each a Principled
+BSDF with Blender's defaults except:
 
 * back row: ``Default`` (base 0.8, roughness 0.5, IOR 1.5, specular IOR
   level 0.5, multiscatter GGX); ``Metal`` (metallic 1, base (1, 0.78, 0.34),
-  roughness 0.3); ``TintedMetal`` (metallic 1, base (0.95, 0.64, 0.54),
-  specular tint (0.9, 0.45, 0.3) as the F82 tint, roughness 0.55, GGX);
+  roughness 0.3); ``Transmission`` (transmission 1, roughness 0.15, IOR
+  1.45, base (0.9, 1, 0.9)), in the corner away from the light so that its
+  caustic falls on open floor;
 * middle row: ``Coat`` (red base (0.8, 0.05, 0.04), coat weight 1, coat
   roughness 0.1, coat tint (0.8, 0.9, 1)); ``Sheen`` (dark blue base
-  (0.03, 0.05, 0.25), sheen weight 1, sheen roughness 0.3); ``Transmission``
-  (transmission 1, roughness 0.15, IOR 1.45, base (0.9, 1, 0.9));
+  (0.03, 0.05, 0.25), sheen weight 1, sheen roughness 0.3); ``TintedMetal``
+  (metallic 1, base (0.95, 0.64, 0.54), specular tint (0.9, 0.45, 0.3) as the
+  F82 tint, roughness 0.55, GGX);
 * front row: ``Alpha`` (base (0.8, 0.55, 0.15), alpha 0.5);
   ``RoughDiffuse`` (base (0.55, 0.7, 0.45), diffuse roughness 1, specular IOR
   level 0.2); ``Specular`` (base (0.15, 0.15, 0.18), specular IOR level 1,
@@ -40,13 +43,13 @@ SPACING = 1.05
 VARIANTS = (
     ("Default", {}),
     ("Metal", dict(metallic=1.0, base_color=(1.0, 0.78, 0.34), roughness=0.3)),
-    ("TintedMetal", dict(metallic=1.0, base_color=(0.95, 0.64, 0.54),
-                         specular_tint=(0.9, 0.45, 0.3), roughness=0.55, distribution="GGX")),
+    ("Transmission", dict(transmission_weight=1.0, roughness=0.15, ior=1.45,
+                          base_color=(0.9, 1.0, 0.9))),
     ("Coat", dict(base_color=(0.8, 0.05, 0.04), coat_weight=1.0, coat_roughness=0.1,
                   coat_tint=(0.8, 0.9, 1.0))),
     ("Sheen", dict(base_color=(0.03, 0.05, 0.25), sheen_weight=1.0, sheen_roughness=0.3)),
-    ("Transmission", dict(transmission_weight=1.0, roughness=0.15, ior=1.45,
-                          base_color=(0.9, 1.0, 0.9))),
+    ("TintedMetal", dict(metallic=1.0, base_color=(0.95, 0.64, 0.54),
+                         specular_tint=(0.9, 0.45, 0.3), roughness=0.55, distribution="GGX")),
     ("Alpha", dict(base_color=(0.8, 0.55, 0.15), alpha=0.5)),
     ("RoughDiffuse", dict(base_color=(0.55, 0.7, 0.45), diffuse_roughness=1.0,
                           specular_ior_level=0.2)),
@@ -65,7 +68,7 @@ def build(scene):
                         location=((column - 1) * SPACING, (1 - row) * SPACING, RADIUS))
     c.add_light(scene, "Key", "AREA", 300.0, (-2.0, -2.2, 3.6), target=(0.0, 0.0, 0.3),
                 shape="SQUARE", size=3.0)
-    c.add_camera(scene, (0.0, -4.4, 3.3), (0.0, 0.05, 0.3), lens_mm=45.0)
+    c.add_camera(scene, (0.0, -3.2, 4.9), (0.0, 0.0, 0.3), lens_mm=58.0)
 
 
 if __name__ == "__main__":

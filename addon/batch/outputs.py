@@ -16,8 +16,15 @@ return normally after a short write), which is why the files are read back.
 * :data:`COMMIT_LOCK` is held while files are renamed into place: the
   command line's signal handler takes it before it ends the process, so an
   exit never falls between the renames of one command's outputs;
-* :func:`pending` lists the temporary files and folders in flight, which that
-  handler removes before it ends the process.
+* :func:`pending` lists the temporary files and folders in flight, and
+  :func:`remove_pending` removes them, as that handler does before it ends the
+  process;
+* :func:`touch_placeholder` creates Blender's placeholder for a frame being
+  rendered (an empty file at the target, so that other machines rendering
+  the same animation skip the frame); :func:`remove_placeholder` removes it
+  if it is still empty once the frame is abandoned, and so does
+  :func:`remove_pending`.  Committing a target takes its placeholder off the
+  list (both under :data:`COMMIT_LOCK`).
 
 A symbolic link as target is followed (the file it points to is replaced, as
 a plain write would do).  No bpy here.
@@ -34,7 +41,8 @@ import threading
 import zlib
 from pathlib import Path
 
-__all__ = ["OutputError", "COMMIT_LOCK", "pending", "Staging", "staged_folder", "write_folder", "verify",
+__all__ = ["OutputError", "COMMIT_LOCK", "pending", "remove_pending", "touch_placeholder",
+           "remove_placeholder", "Staging", "staged_folder", "write_folder", "verify",
            "verify_exr", "verify_png", "resolve", "same_file", "TEMP_MARK"]
 
 # Temporary files are named ".NAME.mcengine-XXXXXXXX.tmp" next to their target.
@@ -43,6 +51,7 @@ TEMP_MARK = ".mcengine-"
 COMMIT_LOCK = threading.RLock()
 _pending_lock = threading.Lock()
 _pending: set[Path] = set()
+_placeholders: set[Path] = set()    # empty files this process created at targets
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # PNG colour type -> channels.
@@ -57,6 +66,53 @@ def pending() -> list[Path]:
     """Temporary files and folders not yet committed or removed (any thread may call)."""
     with _pending_lock:
         return list(_pending)
+
+
+def remove_pending() -> None:
+    """Remove the temporary files and folders in flight, and the placeholders still empty."""
+    for path in pending():
+        if path.is_dir():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                path.unlink()
+    with _pending_lock:
+        placeholders = list(_placeholders)
+    for path in placeholders:
+        remove_placeholder(path)
+
+
+def touch_placeholder(target) -> Path | None:
+    """Create an empty file at ``target`` if nothing is there (Blender's Placeholders).
+
+    Returns the file created (symbolic links followed), or None if the target
+    existed.  Raises OutputError if it cannot be created.
+    """
+    real = resolve(target)
+    try:
+        fd = os.open(real, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+    except FileExistsError:
+        return None
+    except OSError as exc:
+        raise OutputError(f"cannot create the placeholder {real}: {_reason(exc)}") from None
+    os.close(fd)
+    with _pending_lock:
+        _placeholders.add(real)
+    return real
+
+
+def remove_placeholder(path) -> None:
+    """Remove a placeholder made by :func:`touch_placeholder` unless something was written
+    into it or over it since (then it is only forgotten)."""
+    path = Path(path)
+    with COMMIT_LOCK:
+        with _pending_lock:
+            if path not in _placeholders:
+                return
+            _placeholders.discard(path)
+        with contextlib.suppress(OSError):
+            if path.stat().st_size == 0:
+                path.unlink()
 
 
 def _track(path: Path) -> None:
@@ -144,6 +200,8 @@ class Staging:
                 except OSError as exc:
                     raise OutputError(f"cannot write {target}: {_reason(exc)}") from None
                 _untrack(temp)
+                with _pending_lock:
+                    _placeholders.discard(target)   # the image replaced it
             self._files = []
 
     def discard(self) -> None:

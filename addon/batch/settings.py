@@ -20,7 +20,7 @@ __all__ = ["apply_overrides", "set_image_format", "make_unbiased", "TOUCHED_SETT
 
 def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=None,
                     threads=None, frame=None, integrator=None, depth=None,
-                    branching=None) -> None:
+                    branching=None, overwrite=None, placeholders=None) -> None:
     """Change the settings of the next render in memory; None keeps the scene's.
 
     engine      RenderEngine bl_idname ("MCENGINE", "CYCLES")
@@ -32,6 +32,9 @@ def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=N
     integrator, depth, branching
                 MC Engine's algorithm (a name of :mod:`mcengine.integrators`)
                 and its parameters; ignored while the add-on is not registered
+    overwrite, placeholders
+                Output > Overwrite and Placeholders (``render.use_overwrite``,
+                ``render.use_placeholder``), read by the command line's frames
     """
     render = scene.render
     if engine is not None:
@@ -47,6 +50,10 @@ def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=N
         render.threads_mode = "AUTO" if threads == 0 else "FIXED"
         if threads:
             render.threads = threads
+    if overwrite is not None:
+        render.use_overwrite = bool(overwrite)
+    if placeholders is not None:
+        render.use_placeholder = bool(placeholders)
     if frame is not None:
         scene.frame_set(frame)
     own = getattr(scene, "mcengine", None)
@@ -93,7 +100,8 @@ def make_unbiased(scene):
 TOUCHED_SETTINGS = (
     ("render", "engine"), ("render", "resolution_x"), ("render", "resolution_y"),
     ("render", "resolution_percentage"), ("render", "filepath"), ("render", "use_file_extension"),
-    ("render", "threads_mode"), ("render", "threads"),
+    ("render", "threads_mode"), ("render", "threads"), ("render", "use_overwrite"),
+    ("render", "use_placeholder"),
     ("render.image_settings", "media_type"), ("render.image_settings", "file_format"),
     ("render.image_settings", "color_mode"), ("render.image_settings", "color_depth"),
     ("cycles", "samples"), ("cycles", "seed"), ("cycles", "use_denoising"),

@@ -4,13 +4,16 @@ or study what accuracy costs in time.
 Two spellings take the same options::
 
     mcengine render SCENE.blend [--engine mcengine|cycles] [--samples N] [--resolution WxH]
-                                [--seed S] [--frame F] [-o OUT.exr|OUT.png ...] [-F FORMAT]
+                                [--seed S] [-f FRAMES | -s F -e F -j N -a]
+                                [--[no-]overwrite] [--[no-]placeholders]
+                                [-o OUT.exr|OUT.png ...] [-F FORMAT]
                                 [--integrator path|raycast|whitted|distribution]
                                 [--depth R] [--branching B]
-    mcengine -b SCENE.blend -E MCENGINE -o /tmp/out_#### -F OPEN_EXR -f 1
+    mcengine -b SCENE.blend -E MCENGINE -o /tmp/out_#### -F OPEN_EXR -f 1,3,5..7
 
-The second one is Blender's own background-render syntax (``-b -E -o -f -F -S -t``
-and their long forms), so ``blender -b`` scripts carry over unchanged.
+The second one is Blender's own background-render syntax (``-b -E -o -f -a -s -e
+-j -F -S -t`` and their long forms), so ``blender -b`` scripts carry over
+unchanged; frame options act in order, as in Blender (see ``frames``).
 
 ``compare`` renders a scene with both engines and tests whether they agree
 (see ``mcengine_blender.batch.comparison`` and ``mcengine.evaluation``)::
@@ -50,8 +53,13 @@ Conventions
   ``$TMPDIR``, Blender's included, removed at exit.
 * Output paths follow Blender: ``//`` is the .blend file's folder, the last run
   of ``#`` in the file name becomes the zero-padded frame number, and the
-  format's extension is appended when the name has none.  ``-o`` may be given
+  format's extension is appended when the name has none; when several frames
+  can render, a name without ``#`` gets four frame digits.  ``-o`` may be given
   several times to save the same render in several formats.
+* Frames given with ``-f``/``-a`` follow Output > Overwrite and Placeholders as
+  Blender's animation render does (skip frames whose images exist; an empty
+  file while a frame renders).  Each frame is committed and its paths printed
+  as soon as it is rendered; stderr gets one line per frame.
 * Overrides change this render only, never the file.  Samples go to
   ``scene.cycles.samples`` and the seed to ``scene.cycles.seed`` (MC Engine reads
   Cycles' sampling settings); ``--resolution`` sets x, y and 100 %.
@@ -73,6 +81,7 @@ Conventions
 Layout
 ------
 * ``args``: the parser, the validators and the requests they produce (no bpy);
+* ``frames``: Blender's frame options and frame-numbered names (no bpy);
 * ``console``: Blender's log captured, the progress display;
 * ``commands``: what ``render``, ``compare`` and ``study`` do (bpy from here on);
 * ``signals``: SIGINT and SIGTERM, the temporary folder, ending early and cleanly;

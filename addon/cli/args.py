@@ -28,10 +28,19 @@ from mcengine.integrators import NAMES as INTEGRATOR_NAMES
 
 from ..batch.render import ENGINES
 from .errors import PROG, CliError
+from .frames import (
+    FrameAction,
+    frame_path,
+    parse_frame_list,
+    parse_relative,
+    parse_step,
+    plan_frames,
+    renders_several,
+)
 
 __all__ = ["RenderRequest", "CompareRequest", "StudyRequest", "Output", "parse_args",
            "build_parser", "check_blend_file", "check_output_folder", "check_output_paths",
-           "check_folder_creatable", "frame_path", "partial_path"]
+           "check_folder_creatable", "partial_path"]
 
 DEFAULT_ENGINE = ENGINES["mcengine"]
 
@@ -49,7 +58,6 @@ OTHER_IMAGE_EXTENSIONS = {".jpg", ".jpeg", ".tif", ".tiff", ".hdr", ".bmp", ".tg
 MIN_RESOLUTION, MAX_RESOLUTION = 4, 65536
 MAX_SAMPLES = 16_777_216
 MAX_SEED = 2_147_483_647
-MAX_FRAME = 1_048_574
 MAX_THREADS = 1024
 # compare: renders per engine.  Two is the minimum that estimates the noise;
 # more than this is never needed (the test pools every pixel's variance).
@@ -97,17 +105,6 @@ def _seed(text: str) -> int:
         raise argparse.ArgumentTypeError(f"seed must be a whole number, got {text!r}") from None
     if not 0 <= value <= MAX_SEED:
         raise argparse.ArgumentTypeError(f"seed must be between 0 and {MAX_SEED}, got {value}")
-    return value
-
-
-def _frame(text: str) -> int:
-    if text[:1] in "+-" or not text.isdigit():
-        raise argparse.ArgumentTypeError(
-            f"frame must be one absolute frame number, got {text!r} "
-            "(relative frames and ranges are not supported)")
-    value = int(text)
-    if value > MAX_FRAME:
-        raise argparse.ArgumentTypeError(f"frame must be at most {MAX_FRAME}, got {value}")
     return value
 
 
@@ -213,6 +210,68 @@ def _format(text: str) -> str:
     return name
 
 
+class _FrameOption(argparse.Action):
+    """Collects -f, -a, -s, -e and -j in command-line order (Blender applies them in order)."""
+
+    PARSE = {"frames": parse_frame_list, "start": lambda t: parse_relative(t, "-s/--frame-start"),
+             "end": lambda t: parse_relative(t, "-e/--frame-end"), "step": parse_step,
+             "animation": lambda t: None}
+
+    def __init__(self, option_strings, dest, kind, **kwargs):
+        self.kind = kind
+        super().__init__(option_strings, dest, nargs=0 if kind == "animation" else None, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        text = values if isinstance(values, str) else ""
+        action = FrameAction(self.kind, self.PARSE[self.kind](text), text)
+        setattr(namespace, self.dest, (*(getattr(namespace, self.dest) or ()), action))
+
+
+# Frame options whose value may start with '-' (an end-relative frame): argparse would
+# take "-2" for an option, so such values are attached to their option first.
+_FRAME_VALUE_OPTIONS = ("-f", "--frame", "--render-frame", "-s", "--frame-start", "-e",
+                        "--frame-end", "-j", "--frame-jump")
+
+
+def _add_frame_options(parser) -> None:
+    """Blender's frame options: -f (frames, lists, ranges), -a, -s, -e, -j."""
+    def add(*names, kind, help, metavar=None):
+        parser.add_argument(*names, dest="frame_actions", action=_FrameOption, kind=kind,
+                            default=(), help=help, **({"metavar": metavar} if metavar else {}))
+
+    add("-f", "--frame", "--render-frame", kind="frames", metavar="FRAMES",
+        help="frames to render: N, +N (from the start frame), -N (from the end: -1 is the "
+             "end frame), lists and ranges as 1,3,5..7 (default: the file's current frame)")
+    add("-a", "--render-anim", kind="animation",
+        help="render the animation: start to end frame, every step frames")
+    add("-s", "--frame-start", kind="start", metavar="F",
+        help="start frame for -a and +N of -f (+N/-N: relative to the file's start)")
+    add("-e", "--frame-end", kind="end", metavar="F",
+        help="end frame for -a and -N of -f (+N/-N: relative to the file's end)")
+    add("-j", "--frame-jump", kind="step", metavar="N", help="frame step of -a")
+    parser.add_argument("--overwrite", action=argparse.BooleanOptionalAction, default=None,
+                        help="with -f/-a: replace existing images (default: the file's Output > "
+                             "Overwrite); --no-overwrite skips frames whose images exist")
+    parser.add_argument("--placeholders", action=argparse.BooleanOptionalAction, default=None,
+                        help="with -f/-a: create an empty image file while its frame renders, so "
+                             "other machines skip it (default: the file's Output > Placeholders)")
+
+
+def _attach_frame_values(argv: list[str]) -> list[str]:
+    """``-f -2`` -> ``-f-2`` and ``--frame -2`` -> ``--frame=-2``."""
+    out, i = [], 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg in _FRAME_VALUE_OPTIONS and i + 1 < len(argv) and argv[i + 1].startswith("-") \
+                and argv[i + 1][1:2].isdigit():
+            out.append(arg + ("=" if arg.startswith("--") else "") + argv[i + 1])
+            i += 2
+        else:
+            out.append(arg)
+            i += 1
+    return out
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``mcengine`` parser with its ``render`` subcommand."""
     parser = _Parser(
@@ -223,8 +282,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     render = commands.add_parser(
-        "render", help="render one frame of a .blend file",
-        description="Render one frame of a .blend file and save it as EXR and/or PNG.")
+        "render", help="render a frame, a list of frames or the animation of a .blend file",
+        description="Render frames of a .blend file and save them as EXR and/or PNG "
+                    "(by default the file's current frame).")
     render.add_argument("blendfile", metavar="SCENE.blend", help="the file to render")
     render.add_argument("-E", "--engine", type=_engine, default=None,
                         help="mcengine (default) or cycles; Blender's MCENGINE/CYCLES also work")
@@ -234,8 +294,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="image size in pixels, at 100%% (default: the file's)")
     render.add_argument("--seed", type=_seed, default=None,
                         help="sampling seed (default: the file's Cycles seed)")
-    render.add_argument("-f", "--frame", "--render-frame", dest="frame", type=_frame,
-                        default=None, metavar="F", help="frame to render (default: the file's current frame)")
+    _add_frame_options(render)
     render.add_argument("-o", "--output", "--render-output", dest="outputs", action="append",
                         default=None, metavar="PATH",
                         help="output image; .exr or .png, '//' = folder of the .blend, "
@@ -380,14 +439,12 @@ def _blender_style(argv: list[str]) -> list[str]:
     """Rewrite Blender's ``-b FILE ...`` syntax to ``render FILE ...``.
 
     ``-b`` takes no value in Blender (the file is a separate argument), so it is
-    simply dropped; ``-a`` (animation) and the frame-range flags are refused
-    because this command renders one frame.
+    simply dropped; Python options are refused (this command runs no scripts).
     """
-    unsupported = {"-a", "--render-anim", "-s", "--frame-start", "-e", "--frame-end",
-                   "-j", "--frame-jump", "-P", "--python", "--python-expr", "-x", "--use-extension"}
+    unsupported = {"-P", "--python", "--python-expr", "-x", "--use-extension"}
     for arg in argv:
         if arg in unsupported:
-            raise CliError(f"Blender option {arg} is not supported (renders one frame; see {PROG} render --help)")
+            raise CliError(f"Blender option {arg} is not supported (see {PROG} render --help)")
     return ["render"] + [arg for arg in argv if arg not in ("-b", "--background")]
 
 
@@ -409,7 +466,6 @@ class RenderRequest:
     samples: int | None
     resolution: tuple[int, int] | None
     seed: int | None
-    frame: int | None
     scene: str | None
     threads: int | None
     verbose: bool
@@ -417,6 +473,15 @@ class RenderRequest:
     depth: int | None = None
     branching: int | None = None
     keep_partial: bool = False
+    # -f, -a, -s, -e, -j in order (frames.plan_frames); empty: the file's current frame.
+    frame_actions: tuple = ()
+    overwrite: bool | None = None       # None: the file's render.use_overwrite
+    placeholders: bool | None = None    # None: the file's render.use_placeholder
+
+    @property
+    def several_frames(self) -> bool:
+        """Rendered through Blender's frame options: output names get frame digits."""
+        return renders_several(self.frame_actions)
 
 
 def check_blend_file(path: Path) -> None:
@@ -456,8 +521,13 @@ def _os_reason(exc: OSError) -> str:
     return exc.strerror or str(exc)
 
 
-def _output_for(raw: str, forced_format: str | None, blend_dir: Path) -> Output:
-    """Resolve ``//`` and the format of one ``-o`` value (frame digits come later)."""
+def _output_for(raw: str, forced_format: str | None, blend_dir: Path,
+                several: bool = False) -> Output:
+    """Resolve ``//`` and the format of one ``-o`` value (frame digits come later).
+
+    With ``several`` frames, a file name without ``#`` gets Blender's four frame
+    digits at its end, before the extension (``out`` -> ``out####.exr``).
+    """
     text = raw
     if text.startswith("//"):
         text = str(blend_dir / text[2:])
@@ -471,9 +541,11 @@ def _output_for(raw: str, forced_format: str | None, blend_dir: Path) -> Output:
     if forced_format and by_extension and by_extension != forced_format:
         raise CliError(f"output {raw} has extension {suffix} but the format is {forced_format}")
     file_format = forced_format or by_extension or DEFAULT_FORMAT
-    if by_extension is None:
-        pattern = pattern.with_name(pattern.name + FORMATS[file_format])
-    return Output(pattern, file_format)
+    extension = pattern.suffix if by_extension else FORMATS[file_format]
+    stem = pattern.name[:-len(extension)] if by_extension else pattern.name
+    if several and "#" not in stem:
+        stem += "####"
+    return Output(pattern.with_name(stem + extension), file_format)
 
 
 def check_output_folder(path: Path) -> None:
@@ -651,7 +723,7 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest
     if not argv:
         raise CliError(f"no command given (try '{PROG} render SCENE.blend' or '{PROG} --help')")
     try:
-        args = parser.parse_args(argv)
+        args = parser.parse_args(_attach_frame_values(argv))
     except SystemExit as exc:  # --help / --version
         if exc.code:
             raise
@@ -666,34 +738,49 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest
     if args.keep_partial and engine != DEFAULT_ENGINE:
         raise CliError("--keep-partial applies to MC Engine renders only (a Cycles render "
                        "cannot be stopped part-way from Python)")
+    actions = tuple(args.frame_actions)
+    _check_frame_actions(actions, args)
+    several = renders_several(actions)
     blendfile = Path(args.blendfile).absolute()
     check_blend_file(blendfile)
-    raw_outputs = args.outputs or [f"{blendfile.stem}{FORMATS[args.format or DEFAULT_FORMAT]}"]
-    outputs = tuple(_output_for(raw, args.format, blendfile.parent) for raw in raw_outputs)
+    default_name = f"{blendfile.stem}{'_####' if several else ''}"
+    raw_outputs = args.outputs or [default_name + FORMATS[args.format or DEFAULT_FORMAT]]
+    outputs = tuple(_output_for(raw, args.format, blendfile.parent, several)
+                    for raw in raw_outputs)
     for output in outputs:
         check_output_folder(output.pattern)
-    # The frame is known now if it was given or no name has '#'; otherwise the
-    # same check runs once the file is loaded (commands.run_render).
-    if args.frame is not None or not any("#" in o.pattern.name for o in outputs):
-        check_output_paths([frame_path(o.pattern, args.frame or 0) for o in outputs], blendfile)
+    # The frames are known now if they are absolute numbers (or no name has '#');
+    # otherwise the same check runs once the file is loaded (commands.run_render).
+    absolute = all(a.kind == "frames" and all(not f.sign for pair in a.value for f in pair)
+                   for a in actions)
+    if absolute and actions:
+        frames = plan_frames(actions, 0, 0, 1).frames
+        check_output_paths([frame_path(o.pattern, f) for f in frames for o in outputs],
+                           blendfile)
+    elif not any("#" in o.pattern.name for o in outputs):
+        check_output_paths([o.pattern for o in outputs], blendfile)
     return RenderRequest(
         blendfile=blendfile, engine=engine, outputs=outputs,
-        samples=args.samples, resolution=args.resolution, seed=args.seed, frame=args.frame,
+        samples=args.samples, resolution=args.resolution, seed=args.seed,
         scene=args.scene, threads=args.threads, verbose=args.verbose,
         integrator=args.integrator, depth=args.depth, branching=args.branching,
-        keep_partial=args.keep_partial)
+        keep_partial=args.keep_partial, frame_actions=actions, overwrite=args.overwrite,
+        placeholders=args.placeholders)
+
+
+def _check_frame_actions(actions, args) -> None:
+    """-s, -e and -j act on the -a and -f after them; Overwrite/Placeholders need frames."""
+    renders = [i for i, a in enumerate(actions) if a.kind in ("animation", "frames")]
+    late = [a for i, a in enumerate(actions)
+            if a.kind in ("start", "end", "step") and (not renders or i > renders[-1])]
+    if late:
+        option = {"start": "-s", "end": "-e", "step": "-j"}[late[0].kind]
+        raise CliError(f"{option} changes the frames of the -a or -f after it, and none follows "
+                       f"(Blender applies frame options in order: put {option} before -a/-f)")
+    if not renders and (args.overwrite is not None or args.placeholders is not None):
+        raise CliError("--overwrite and --placeholders apply to frames given with -f or -a")
 
 
 def partial_path(path: Path) -> Path:
     """Where ``--keep-partial`` saves an interrupted render: ``shot.exr`` -> ``shot.partial.exr``."""
     return path.with_name(f"{path.stem}.partial{path.suffix}")
-
-
-def frame_path(pattern: Path, frame: int) -> Path:
-    """Replace the last run of ``#`` in the file name with the zero-padded frame."""
-    runs = list(re.finditer(r"#+", pattern.name))
-    if not runs:
-        return pattern
-    last = runs[-1]
-    name = pattern.name[:last.start()] + str(frame).zfill(len(last[0])) + pattern.name[last.end():]
-    return pattern.with_name(name)

@@ -13,7 +13,14 @@ import time
 from pathlib import Path
 
 from ..batch import interrupt
-from ..batch.outputs import OutputError, Staging, verify, write_folder
+from ..batch.outputs import (
+    OutputError,
+    Staging,
+    remove_placeholder,
+    touch_placeholder,
+    verify,
+    write_folder,
+)
 from ..batch.render import (
     ENGINES,
     NoSuchScene,
@@ -25,9 +32,10 @@ from ..batch.render import (
 )
 from ..batch.settings import apply_overrides, set_image_format
 from . import signals
-from .args import CompareRequest, RenderRequest, StudyRequest, check_output_paths, frame_path, partial_path
+from .args import CompareRequest, RenderRequest, StudyRequest, check_output_paths, partial_path
 from .console import BlenderLog, Progress, engine_traceback, warning_lines
 from .errors import EXIT_DIFFER, EXIT_OK, EXIT_RENDER_FAILED, PROG, CliError
+from .frames import frame_path, plan_frames
 
 __all__ = ["run_render", "run_compare", "run_study", "study_line"]
 
@@ -122,8 +130,10 @@ def _open(path: Path, scene_name: str | None):
         raise CliError(str(exc), EXIT_RENDER_FAILED) from None
 
 
-def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderLog) -> int:
-    """Render once and save every output; returns the samples per pixel rendered.
+def _render(bpy, scene, request: RenderRequest, targets, log: BlenderLog,
+            progress: Progress) -> int | None:
+    """Render once and save the image to every (output, path) of ``targets``; returns the
+    samples per pixel rendered.
 
     Raises CliError on any failure and Interrupted if the command was stopped;
     in both cases no output is touched (with ``--keep-partial``, an
@@ -133,7 +143,6 @@ def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderL
     if ours:
         from ..engine import last_render
         last_render.clear()   # what is left in it afterwards is this render's
-    progress = Progress(log.console, request.engine)
     log_start = log.mark()
     interrupt.check()
     bpy.app.handlers.render_stats.append(progress.on_stats)
@@ -152,12 +161,12 @@ def _render(bpy, scene, request: RenderRequest, paths: list[Path], log: BlenderL
         raise CliError(f"render failed: {request.engine} raised {crash}", EXIT_RENDER_FAILED)
     if interrupt.requested() is not None:
         if request.keep_partial and ours:
-            partials = [partial_path(path) for path in paths]
-            _save(bpy, scene, request.outputs, partials, log)
+            partials = [(output, partial_path(path)) for output, path in targets]
+            _save(bpy, scene, partials, log)
             log.console.write(f"{PROG}: kept the partial image ({_samples_done(ours, progress)} "
-                              f"samples) in {', '.join(map(str, partials))}\n")
+                              f"samples) in {', '.join(str(p) for _, p in partials)}\n")
         interrupt.check()
-    _save(bpy, scene, request.outputs, paths, log)
+    _save(bpy, scene, targets, log)
     return _samples_done(ours, progress)
 
 
@@ -171,12 +180,12 @@ def _samples_done(ours: bool, progress: Progress) -> int | None:
     return progress.done
 
 
-def _save(bpy, scene, outputs, paths: list[Path], log: BlenderLog) -> None:
-    """Save the Render Result to every path: temporary files next to the targets,
-    read back, then renamed over the targets together (batch.outputs)."""
+def _save(bpy, scene, targets, log: BlenderLog) -> None:
+    """Save the Render Result to every (output, path): temporary files next to the
+    targets, read back, then renamed over the targets together (batch.outputs)."""
     result = bpy.data.images["Render Result"]
     with Staging() as staging:
-        for output, path in zip(outputs, paths):
+        for output, path in targets:
             try:
                 temp = staging.temp(path)
             except OutputError as exc:
@@ -199,7 +208,7 @@ def _save(bpy, scene, outputs, paths: list[Path], log: BlenderLog) -> None:
 
 
 def _unchanged(path: Path) -> str:
-    return "; the existing file is unchanged" if path.exists() else ""
+    return "; the existing file is unchanged" if path.exists() and path.stat().st_size else ""
 
 
 def _ray_accounting() -> str | None:
@@ -208,8 +217,43 @@ def _ray_accounting() -> str | None:
     return last_render.get("accounting")
 
 
+def _frames(scene, request: RenderRequest, console) -> tuple[int, ...]:
+    """The frames the request renders (the file's current frame if none was given)."""
+    if not request.frame_actions:
+        return (scene.frame_current,)
+    plan = plan_frames(request.frame_actions, scene.frame_start, scene.frame_end,
+                       scene.frame_step)
+    for warning in plan.warnings:
+        console.write(f"{PROG}: warning: {warning}\n")
+    return plan.frames
+
+
+class _Warnings:
+    """Blender's ``Warning:`` lines, each passed on once (an animation repeats them)."""
+
+    def __init__(self, log: BlenderLog):
+        self.log = log
+        self.start = log.mark()
+        self.seen: set[str] = set()
+
+    def flush(self) -> None:
+        for warning in warning_lines(self.log.text(since=self.start)):
+            if warning not in self.seen:
+                self.seen.add(warning)
+                self.log.console.write(f"{PROG}: warning: {warning}\n")
+        self.start = self.log.mark()
+
+
 def run_render(request: RenderRequest) -> int:
-    """Load, render and save; returns the exit status."""
+    """Load, then render and save each frame; returns the exit status.
+
+    Frames given with -f or -a follow Blender's Output > Overwrite (off: a frame
+    whose images all exist is skipped, and only the missing images of the
+    others are written) and Placeholders (an empty file at each image while its
+    frame renders, removed if the frame is not saved).  Each frame's images are
+    committed as soon as it is rendered, and their paths printed, so a stop
+    leaves the finished frames in place.
+    """
     log = BlenderLog(passthrough=request.verbose)
     started = time.monotonic()
     ours = request.engine == ENGINES["mcengine"]
@@ -219,35 +263,104 @@ def run_render(request: RenderRequest) -> int:
         interrupt.check()
         apply_overrides(scene, engine=request.engine, samples=request.samples, seed=request.seed,
                         resolution=request.resolution, threads=request.threads,
-                        frame=request.frame, integrator=request.integrator,
-                        depth=request.depth, branching=request.branching)
-    frame = scene.frame_current
-    paths = [frame_path(output.pattern, frame) for output in request.outputs]
-    # Again now that the frame is known ('#' in a name), before anything is rendered.
-    check_output_paths(paths, request.blendfile)
+                        integrator=request.integrator, depth=request.depth,
+                        branching=request.branching, overwrite=request.overwrite,
+                        placeholders=request.placeholders)
+    frames = _frames(scene, request, log.console)
+    paths = {frame: [frame_path(output.pattern, frame) for output in request.outputs]
+             for frame in frames}
+    # Again now that the frames are known ('#' in a name), before anything is rendered.
+    check_output_paths([path for frame in frames for path in paths[frame]], request.blendfile)
     if request.keep_partial:
-        check_output_paths([partial_path(path) for path in paths], request.blendfile)
-    samples = _render(bpy, scene, request, paths, log)
-    for warning in warning_lines(log.text()):
-        log.console.write(f"{PROG}: warning: {warning}\n")
-    render = scene.render
-    scale = render.resolution_percentage / 100
-    asked = scene.cycles.samples
-    if samples is None or samples == asked:
-        samples_text = f"{asked} samples"
-    else:
-        samples_text = f"{samples} of {asked} samples"
-    log.console.write(
-        f"{PROG}: rendered {scene.name!r} frame {frame} with {request.engine}, "
-        f"{round(render.resolution_x * scale)}x{round(render.resolution_y * scale)}, "
-        f"{samples_text}, in {time.monotonic() - started:.1f} s\n")
-    if ours:
+        check_output_paths([partial_path(path) for frame in frames for path in paths[frame]],
+                           request.blendfile)
+    by_frame = len(frames) > 1          # one line per frame instead of per 10 %
+    rules = bool(request.frame_actions)  # Blender's Overwrite and Placeholders apply
+    warnings = _Warnings(log)
+    rendered = skipped = 0
+    samples = None
+    for index, frame in enumerate(frames):
+        interrupt.check()
+        where = f"frame {frame} [{index + 1}/{len(frames)}]"
+        targets = list(zip(request.outputs, paths[frame]))
+        if rules and not scene.render.use_overwrite:
+            targets = [(output, path) for output, path in targets if not path.exists()]
+            if not targets:
+                skipped += 1
+                log.console.write(f"{PROG}: {where}: skipped, "
+                                  f"{' and '.join(map(str, paths[frame]))} exist"
+                                  f"{'s' if len(paths[frame]) == 1 else ''} (Overwrite is off)\n")
+                continue
+        frame_started = time.monotonic()
+        with log.capture():
+            scene.frame_set(frame)     # animation, drivers and the animated seed follow
+        label = f"{request.engine} {where}" if by_frame else request.engine
+        samples = _render_frame(bpy, scene, request, targets, log,
+                                Progress(log.console, label, lines=not by_frame),
+                                placeholders=rules and scene.render.use_placeholder,
+                                where=where if by_frame else None)
+        rendered += 1
+        warnings.flush()
+        if by_frame:
+            log.console.write(f"{PROG}: {where}: {_samples_text(samples, scene)}, "
+                              f"{time.monotonic() - frame_started:.1f} s\n")
+        for _, path in targets:
+            print(path, flush=True)
+    _summary(log.console, scene, request, frames, rendered, skipped, samples,
+             time.monotonic() - started)
+    if ours and rendered and not by_frame:
         accounting = _ray_accounting()
         if accounting:
             log.console.write(f"{PROG}: {accounting}\n")
-    for path in paths:
-        print(path)
     return EXIT_OK
+
+
+def _render_frame(bpy, scene, request, targets, log, progress, placeholders: bool,
+                  where: str | None) -> int | None:
+    """:func:`_render`, with Blender's placeholders around it and the frame named in errors."""
+    made = []
+    try:
+        if placeholders:
+            for _, path in targets:
+                try:
+                    made.append(touch_placeholder(path))
+                except OutputError as exc:
+                    raise CliError(str(exc), EXIT_RENDER_FAILED) from None
+        return _render(bpy, scene, request, targets, log, progress)
+    except CliError as exc:
+        if where is None:
+            raise
+        raise CliError(f"{where}: {exc}", exc.exit_code) from None
+    finally:
+        for path in made:
+            if path is not None:
+                remove_placeholder(path)    # unless the image replaced it
+
+
+def _samples_text(samples: int | None, scene) -> str:
+    asked = scene.cycles.samples
+    if samples is None or samples == asked:
+        return f"{asked} samples"
+    return f"{samples} of {asked} samples"
+
+
+def _summary(console, scene, request, frames, rendered, skipped, samples, seconds) -> None:
+    render = scene.render
+    scale = render.resolution_percentage / 100
+    size = f"{round(render.resolution_x * scale)}x{round(render.resolution_y * scale)}"
+    if len(frames) == 1 and rendered:
+        console.write(f"{PROG}: rendered {scene.name!r} frame {frames[0]} with {request.engine}, "
+                      f"{size}, {_samples_text(samples, scene)}, in {seconds:.1f} s\n")
+        return
+    what = f"frame {frames[0]}" if len(frames) == 1 else (
+        f"frames {frames[0]}..{frames[-1]}" if list(frames) == list(
+            range(frames[0], frames[-1] + 1)) else f"{len(frames)} frames")
+    line = (f"{PROG}: rendered {rendered} of {len(frames)} frame{'s' if len(frames) > 1 else ''} "
+            f"of {scene.name!r} ({what}) with {request.engine}, {size}, "
+            f"{scene.cycles.samples} samples, in {seconds:.1f} s")
+    if skipped:
+        line += f"; {skipped} skipped (their images exist and Overwrite is off)"
+    console.write(line + "\n")
 
 
 # ---------------------------------------------------------------------------

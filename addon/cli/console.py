@@ -5,7 +5,8 @@
   :func:`engine_traceback` and :func:`warning_lines` read the captured log.
 * :class:`Progress` draws a render's progress from Blender's render
   statistics: a bar redrawn in place on a terminal (as wide as the terminal
-  allows), one line per 10 % otherwise.
+  allows), one line per 10 % otherwise (or none, when the command prints one
+  line per frame of an animation).
 """
 from __future__ import annotations
 
@@ -99,10 +100,11 @@ def warning_lines(log: str) -> list[str]:
 class Progress:
     """Render progress on stderr from Blender's render statistics strings."""
 
-    def __init__(self, stream, label: str):
+    def __init__(self, stream, label: str, lines: bool = True):
         self.stream = stream
         self.label = label
         self.is_tty = stream.isatty()
+        self.lines = lines      # not a terminal: False prints nothing (the caller reports)
         self.start = time.monotonic()
         self._lines_printed = 0  # non-TTY: number of PROGRESS_LINE_STEP steps reported
         self._drawn = False
@@ -128,7 +130,7 @@ class Progress:
             bar = "#" * filled + "." * (PROGRESS_BAR_WIDTH - filled)
             self._draw(f"{self.label} [{bar}] {fraction:4.0%}  sample {done}/{total}  {self._elapsed()}")
             self._drawn = True
-        else:
+        elif self.lines:
             steps = int(fraction / PROGRESS_LINE_STEP + 1e-9)
             if steps > self._lines_printed:
                 self._lines_printed = steps

@@ -14,7 +14,8 @@ A watcher thread therefore learns of the signal at once (through
 acknowledge that it is stopping.  If it does not (a Cycles render cannot be
 cancelled from Python), or when a second signal arrives, the watcher ends
 the process itself: it waits for any rename of outputs in progress
-(:data:`..batch.outputs.COMMIT_LOCK`), removes the temporary files in flight,
+(:data:`..batch.outputs.COMMIT_LOCK`), removes the temporary files in flight
+(and a frame's placeholder still empty),
 this command's temporary folder and Blender's, prints one line and exits
 with 130 (SIGINT) or 143 (SIGTERM).  Outputs are only ever renamed into
 place once complete, so ending the process loses nothing that was there.
@@ -91,12 +92,8 @@ def _outputs():
 def _remove_temporaries() -> None:
     import shutil
     outputs = _outputs()
-    for path in outputs.pending() if outputs is not None else ():
-        if path.is_dir():
-            shutil.rmtree(path, ignore_errors=True)
-        else:
-            with contextlib.suppress(OSError):
-                path.unlink()
+    if outputs is not None:
+        outputs.remove_pending()
     for folder in reversed(_folders):
         shutil.rmtree(folder, ignore_errors=True)
 

@@ -19,9 +19,10 @@ import numpy as np
 import pytest
 
 from mcengine_blender.batch.render import error_message
-from mcengine_blender.cli.args import ZSTD_MAGIC, _output_for, frame_path
+from mcengine_blender.cli.args import ZSTD_MAGIC, _output_for
 from mcengine_blender.cli.console import PROGRESS_BAR_WIDTH, Progress, engine_traceback, warning_lines
 from mcengine_blender.cli.errors import EXIT_BAD_INPUT, EXIT_RENDER_FAILED
+from mcengine_blender.cli.frames import frame_path
 
 REPO = Path(__file__).resolve().parents[2]
 MCENGINE = Path(sys.executable).with_name("mcengine")
@@ -127,7 +128,8 @@ def _raw_blend(path: Path) -> bytes:
     (["render", "{tiny}", "--samples", "-3"], ["sample count", "got -3"]),
     (["render", "{tiny}", "--samples", "x"], ["sample count", "'x'"]),
     (["render", "{tiny}", "--seed", "-1"], ["seed"]),
-    (["render", "{tiny}", "-f", "+1"], ["absolute frame"]),
+    (["render", "{tiny}", "-f", "1,,3"], ["incorrect comma use"]),
+    (["-b", "{tiny}", "-a", "-s", "3"], ["put -s before -a/-f"]),
     (["render", "{tiny}", "-o", "{bad}/missing-dir/out.exr"], ["output folder does not exist"]),
     (["render", "{tiny}", "-o", "{bad}/afile/out.exr"], ["not a folder"]),
     (["render", "{tiny}", "-o", "/proc/out.exr"], ["cannot write to output folder /proc"]),
@@ -135,7 +137,7 @@ def _raw_blend(path: Path) -> bytes:
     (["render", "{tiny}", "-o", "{bad}/out.jpg"], ["unsupported output type '.jpg'"]),
     (["render", "{tiny}", "-o", "{bad}/out.png", "-F", "OPEN_EXR"], ["extension .png", "OPEN_EXR"]),
     (["render", "{tiny}", "-F", "TIFF"], ["unsupported format 'TIFF'"]),
-    (["-b", "{tiny}", "-a"], ["-a is not supported"]),
+    (["-b", "{tiny}", "-P", "script.py", "-a"], ["-P is not supported"]),
     (["render", "{tiny}", "--bogus"], ["unrecognized arguments: --bogus"]),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, fragments, scenes, bad_files):

@@ -41,7 +41,8 @@ from .stats import CHANNELS, Agreement, compare_stacks, relmse, smape, student_t
 
 __all__ = [
     "OURS_LABEL", "CYCLES_LABEL", "EngineRuns", "Comparison", "build_comparison",
-    "differing_regions", "detectable_bias", "SuiteRow", "suite_row", "suite_verdict",
+    "differing_regions", "detectable_bias", "frame_finding", "FrameFinding", "POWER_BIAS",
+    "SuiteRow", "suite_row", "suite_verdict",
 ]
 
 # How reports name the two engines.
@@ -49,8 +50,12 @@ OURS_LABEL = "MC Engine"
 CYCLES_LABEL = "Cycles"
 
 # The detectable bias is the frame bias that the frame test finds with this
-# probability (one-sided normal quantile 1.645).
+# probability (one-sided quantile 1.645 with many degrees of freedom).
 DETECTION_POWER = 0.95
+# A frame test that finds no difference says the frame means *agree* only if it
+# could have found a bias of this size: detectable bias at most POWER_BIAS in
+# every channel.  Otherwise the means are "not distinguishable at this noise".
+POWER_BIAS = 0.05
 
 
 # ----------------------------------------------------------------------------
@@ -110,7 +115,9 @@ class Comparison:
         blocks = self.report["blocks"]
         bias = ", ".join(f"{ch} {100 * v:+.2f}%" for ch, v in
                          self.report["frame"]["rel_bias"].items() if v is not None)
-        return (f"{self.scene}: {self.verdict} (frame MC/Cycles-1 {bias}; "
+        finding = frame_finding(self.report)
+        caveat = f"; {finding.caveat}" if finding.caveat else ""
+        return (f"{self.scene}: {self.verdict} (frame MC/Cycles-1 {bias}{caveat}; "
                 f"{blocks['differ']}/{blocks['tested']} blocks differ; relMSE {m['relmse']:.4g}, "
                 f"FLIP {m['flip']:.3f})")
 
@@ -120,21 +127,89 @@ def detectable_bias(agreement: Agreement, power: float = DETECTION_POWER) -> np.
 
     A frame channel whose Holm-unadjusted p-value is below ``alpha / n_tests``
     is rejected whatever the other tests give, so a bias of
-    ``(z_crit + z_power) * se / mean`` is caught at least with probability
-    ``power`` (normal approximation; ``z_crit`` is the two-sided quantile at
-    ``alpha / n_tests``).
+    ``(t_crit + t_power) * se / mean`` is caught at least with probability
+    ``power``, where ``t_crit`` is the two-sided quantile at ``alpha / n_tests``
+    and ``t_power`` the one-sided quantile at ``power``, both of Student's t
+    with the frame test's Welch degrees of freedom.  With many degrees of
+    freedom these are the normal quantiles (about 4.6 + 1.6 standard errors
+    for 195 tests).  With few, as when a handful of bright pixels carry most of
+    the noise, the quantiles grow, and so does the bias the test can see: the
+    normal quantiles would claim a test some 8 times more sensitive than it is
+    (``tests/core/test_report.py``); these err on the safe side.
 
     Returns
     -------
     (3,) float
         Per RGB channel, relative to Cycles' frame mean (inf where it is 0).
     """
-    z_crit = student_t_isf(agreement.alpha / (2 * max(agreement.n_tests, 1)), math.inf)
-    z_power = student_t_isf(1.0 - power, math.inf)
+    dof = agreement.frame_dof
+    t_crit = student_t_isf(agreement.alpha / (2 * max(agreement.n_tests, 1)), dof)
+    t_power = student_t_isf(1.0 - power, dof)
     se = np.hypot(agreement.frame_se_a, agreement.frame_se_b)
     mean = np.abs(agreement.frame_mean_b)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(mean > 0, (z_crit + z_power) * se / np.where(mean > 0, mean, 1.0), np.inf)
+        return np.where(mean > 0, (t_crit + t_power) * se / np.where(mean > 0, mean, 1.0),
+                        np.inf)
+
+
+@dataclass(frozen=True)
+class FrameFinding:
+    """What the frame test found, in words: ``kind`` is "differ", "agree" or
+    "not distinguishable"; ``headline`` says it, ``values`` gives the frame biases."""
+
+    kind: str
+    headline: str
+    values: str
+    detectable: float       # the largest detectable bias over the channels tested
+
+    @property
+    def text(self) -> str:
+        return f"{self.headline}: {self.values}"
+
+    @property
+    def caveat(self) -> str:
+        """For an "agree" verdict whose frame test lacked power: what it could not see."""
+        if self.kind != "not distinguishable":
+            return ""
+        return f"nothing found, but a frame bias up to {_percent(self.detectable)} could hide " \
+               "in the noise"
+
+
+def frame_finding(report: dict) -> FrameFinding:
+    """The frame test's result as a person should read it.
+
+    * "differ": a channel's frame mean differs significantly;
+    * "agree": none does, and the test could have seen a difference: a bias of
+      :data:`POWER_BIAS` would have been found with :data:`DETECTION_POWER`
+      probability in every channel (detectable bias <= POWER_BIAS);
+    * "not distinguishable": none does, but the noise would have hidden a bias
+      larger than POWER_BIAS; "agree" would claim what the test cannot know.
+    """
+    frame = report["frame"]
+    differs = [ch for ch, d in frame["differs"].items() if d]
+    if differs:
+        return FrameFinding("differ", "frame mean differs", ", ".join(
+            f"{ch} {100 * frame['rel_bias'][ch]:+.1f}%" for ch in differs), math.nan)
+    values = ", ".join(f"{ch} {100 * v:+.2f}%" for ch, v in frame["rel_bias"].items()
+                       if v is not None)
+    detectable = [math.inf if v is None else v for ch, v in frame["detectable_bias"].items()
+                  if frame["rel_bias"][ch] is not None]
+    worst = max(detectable, default=math.inf)
+    if worst <= POWER_BIAS:
+        return FrameFinding("agree", f"frame means agree (detectable bias {_percent(worst)} "
+                                     f"<= {_percent(POWER_BIAS)})", values, worst)
+    return FrameFinding("not distinguishable", "frame means not distinguishable at this noise "
+                                               f"(detectable bias {_percent(worst)})", values,
+                        worst)
+
+
+def _percent(v: float) -> str:
+    """0.0033 -> '0.33 %', 1.35 -> '135 %', 87.2 -> '8.7e+03 %'; inf -> 'unbounded'."""
+    if not math.isfinite(v):
+        return "unbounded"
+    value = 100 * v
+    return f"{value:.2g} %" if value < 100 else (f"{value:.0f} %" if value < 1e4
+                                                 else f"{value:.1e} %")
 
 
 def _where(cx: float, cy: float) -> str:
@@ -281,6 +356,7 @@ def build_comparison(scene: str, ours: EngineRuns, cycles: EngineRuns, *, grid=(
             "p_holm": _channel_dict(agreement.frame_p_holm),
             "differs": {ch: bool(r) for ch, r in zip(CHANNELS, agreement.frame_rejected)},
             "detectable_bias": _channel_dict(detectable_bias(agreement)),
+            "power_bias": POWER_BIAS,
         },
         "metrics": {
             "relmse": relmse(ours_mean, cycles_mean),
@@ -295,6 +371,7 @@ def build_comparison(scene: str, ours: EngineRuns, cycles: EngineRuns, *, grid=(
         "notes": notes,
         "agreement": agreement.to_dict(),
     }
+    report["frame"]["finding"] = frame_finding(report).kind
     if ours.nonfinite:
         # Only when there are any: samples MC Engine dropped, summed over its K renders.
         report["nonfinite_samples"] = int(ours.nonfinite)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..imageio import linear_to_srgb
 from ..integrators import NAMES
-from .comparison import CYCLES_LABEL, OURS_LABEL, Comparison
+from .comparison import CYCLES_LABEL, OURS_LABEL, Comparison, frame_finding
 from .stats import CHANNELS
 from .study import CYCLES, EQUAL_TIME_SLACK, Study, StudyError, engine_label
 
@@ -35,6 +35,10 @@ LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 # The difference panel's colour scale spans +-this percentile of |difference|,
 # so a few fireflies do not wash the rest of the map out.
 DIFFERENCE_SCALE_PERCENTILE = 99.0
+
+# Colours of the verdict and of the frame test's finding (comparison.frame_finding):
+# green agree, red differ, amber when the noise could hide a difference.
+FINDING_COLOURS = {"agree": "#1a7f37", "differ": "#cf222e", "not distinguishable": "#9a6700"}
 
 # Panels are drawn at least this many pixels wide (small renders are scaled up
 # with nearest-neighbour sampling, so every pixel stays visible).
@@ -96,7 +100,7 @@ def side_by_side(c: Comparison, path) -> None:
     panel_w = w * scale_up / COMPARISON_DPI
     panel_h = h * scale_up / COMPARISON_DPI
     # Room above each panel for two title lines, below for the colour bar / captions.
-    top_in, bottom_in, gap_in = 0.95, 0.85, 0.25
+    top_in, bottom_in, gap_in = 0.95, 1.05, 0.25
     fig_w = 4 * panel_w + 5 * gap_in
     fig_h = panel_h + top_in + bottom_in
     fig = Figure(figsize=(fig_w, fig_h), dpi=COMPARISON_DPI, facecolor="white")
@@ -111,9 +115,13 @@ def side_by_side(c: Comparison, path) -> None:
 
     r = c.report
     samples = r["settings"]["samples"]
-    verdict_colour = "#1a7f37" if c.verdict == "agree" else "#cf222e"
-    fig.text(0.5, 1 - 0.12 / fig_h, f"{c.scene}   {w} x {h} px   verdict: {c.verdict.upper()}",
-             ha="center", va="top", fontsize=13, weight="bold", color=verdict_colour)
+    finding = frame_finding(r)
+    verdict = c.verdict.upper()
+    if c.verdict == "agree" and finding.caveat:
+        verdict += f" ({finding.caveat})"
+    fig.text(0.5, 1 - 0.12 / fig_h, f"{c.scene}   {w} x {h} px   verdict: {verdict}",
+             ha="center", va="top", fontsize=13, weight="bold",
+             color=FINDING_COLOURS["differ" if c.verdict == "differ" else finding.kind])
 
     ax = axes(0)
     ax.imshow(_display(ours_mean), interpolation="nearest")
@@ -165,16 +173,12 @@ def side_by_side(c: Comparison, path) -> None:
     n_differ, n_tested = r["blocks"]["differ"], r["blocks"]["tested"]
     ax.set_title(f"significant differences (Holm, alpha {a.alpha:g})\n"
                  f"{n_differ}/{n_tested} blocks differ", fontsize=9)
-    frame = [ch for ch, d in r["frame"]["differs"].items() if d]
-    if frame:
-        caption = "frame mean differs: " + ", ".join(
-            f"{ch} {100 * r['frame']['rel_bias'][ch]:+.1f}%" for ch in frame)
-    else:
-        caption = "frame means agree: " + ", ".join(
-            f"{ch} {100 * v:+.2f}%" for ch, v in r["frame"]["rel_bias"].items() if v is not None)
+    finding = frame_finding(r)
     left = (gap_in + 3 * (panel_w + gap_in) + 0.5 * panel_w) / fig_w
-    fig.text(left, 0.62 * bottom_in / fig_h, caption, ha="center", va="center", fontsize=8,
-             color="#cf222e" if frame else "#333333")
+    fig.text(left, 0.64 * bottom_in / fig_h,
+             finding.headline.replace(" (", "\n(") + "\n" + finding.values,
+             ha="center", va="center", fontsize=8, linespacing=1.3,
+             color=FINDING_COLOURS[finding.kind])
     fig.text(left, 0.3 * bottom_in / fig_h,
              f"red: {OURS_LABEL} brighter, blue: darker; label: MC/Cycles-1, channels",
              ha="center", va="center", fontsize=7, color="#555555")

@@ -15,7 +15,7 @@ import html
 import math
 
 from ..integrators import INTEGRATORS
-from .comparison import DETECTION_POWER, Comparison, SuiteRow
+from .comparison import DETECTION_POWER, POWER_BIAS, Comparison, SuiteRow, frame_finding
 from .stats import CHANNELS
 from .study import (
     CONFIDENCE,
@@ -128,6 +128,13 @@ def report_markdown(c: Comparison) -> str:
               + ", ".join(f"{v:.2f}" for v in r["pixel_correlation"]["mcengine"]) + "; Cycles "
               + ", ".join(f"{v:.2f}" for v in r["pixel_correlation"]["cycles"]) + " |",
               "", "## Regions that differ", ""]
+    finding = frame_finding(r)
+    lines += ["", f"**{finding.text[0].upper() + finding.text[1:]}.** The frame means are said "
+              f"to agree only when no channel differs and the test would have found a "
+              f"{100 * POWER_BIAS:g} % bias with {int(100 * DETECTION_POWER)} % probability in "
+              "every channel (detectable bias at most "
+              f"{100 * POWER_BIAS:g} %); otherwise they are not distinguishable at this noise, "
+              "which says nothing about a bias smaller than the detectable one."]
     frame_differs = [ch for ch, d in r["frame"]["differs"].items() if d]
     if frame_differs:
         lines.append("The whole frame differs in " + ", ".join(
@@ -172,11 +179,23 @@ _COLUMNS = ("scene", "verdict", "frame bias (max abs)", "detectable bias", "bloc
 def _cells(row: SuiteRow) -> list:
     if row.verdict == "error":
         return [row.scene, "**error**", row.error] + [""] * (len(_COLUMNS) - 3)
-    return [row.scene, row.verdict if row.verdict == "agree" else f"**{row.verdict}**",
+    return [row.scene, _verdict_cell(row),
             f"{100 * row.max_abs_bias:.2f} %" if row.max_abs_bias is not None else "",
             f"{100 * row.detectable_bias:.2g} %" if row.detectable_bias is not None else "",
             row.blocks_differ, _num(row.relmse, ".3g"), _num(row.flip, ".3f"),
             _num(row.seconds_ours, ".2f"), _num(row.seconds_cycles, ".2f"), _ratio(row)]
+
+
+def _low_power(row: SuiteRow) -> bool:
+    """An "agree" whose frame test could not have seen a POWER_BIAS bias."""
+    return row.verdict == "agree" and (row.detectable_bias is None
+                                       or row.detectable_bias > POWER_BIAS)
+
+
+def _verdict_cell(row: SuiteRow) -> str:
+    if row.verdict != "agree":
+        return f"**{row.verdict}**"
+    return "agree (low power)" if _low_power(row) else "agree"
 
 
 def _settings_line(rows) -> str:
@@ -188,7 +207,11 @@ def _settings_line(rows) -> str:
             f"{', '.join(spp) or 'n/a'}; {sum(r.verdict == 'agree' for r in rows)} agree, "
             f"{sum(r.verdict == 'differ' for r in rows)} differ, "
             f"{sum(r.verdict == 'error' for r in rows)} failed."
-            + (f" MC Engine dropped non-finite samples in: {', '.join(dropped)}." if dropped else ""))
+            + (f" MC Engine dropped non-finite samples in: {', '.join(dropped)}." if dropped else "")
+            + (f" Low power: the frame test of {sum(map(_low_power, rows))} scene(s) could not "
+               f"have seen a {100 * POWER_BIAS:g} % bias (detectable bias above "
+               f"{100 * POWER_BIAS:g} %); nothing was found there, but nothing is shown to agree."
+               if any(map(_low_power, rows)) else ""))
 
 
 def suite_markdown(rows, thumbnails: bool = True) -> str:

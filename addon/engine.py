@@ -23,6 +23,7 @@ import numpy as np
 from mcengine.scene import SceneError
 
 from . import export
+from .preview import preview_integrator
 
 __all__ = ["ENGINE_ID", "MCEngine", "session_factory", "register", "unregister"]
 
@@ -50,7 +51,7 @@ last_render: dict = {}
 
 
 class MCEngine(bpy.types.RenderEngine):
-    """Final renders with mcengine (no viewport or preview rendering yet)."""
+    """Final renders and material, light and world previews with mcengine."""
 
     bl_idname = ENGINE_ID
     bl_label = "MC Engine"
@@ -58,10 +59,11 @@ class MCEngine(bpy.types.RenderEngine):
     bl_use_shading_nodes_custom = False
     # Material Preview viewport shading uses EEVEE, as for Cycles.
     bl_use_eevee_viewport = True
+    # Material, light and world previews (and their icons) render with MC Engine
+    # (see preview.py).
+    bl_use_preview = True
 
     def render(self, depsgraph):
-        if self.is_preview:
-            return  # bl_use_preview is False; nothing to draw for material previews
         desc, session = self._prepare(depsgraph)
         if session is None:
             return
@@ -80,7 +82,8 @@ class MCEngine(bpy.types.RenderEngine):
             except Exception as exc:
                 self._fail(_describe(exc, "reading the image"), exc)
             self.end_result(result)
-            self._record(depsgraph.scene.original, session)
+            if not self.is_preview:
+                self._record(depsgraph.scene.original, session)
 
     # -- steps ---------------------------------------------------------------
     def _prepare(self, depsgraph):
@@ -96,7 +99,9 @@ class MCEngine(bpy.types.RenderEngine):
         seconds = time.perf_counter() - start
         self._export_seconds = seconds
         log.info("scene exported in %.3f s", seconds)
-        for warning in exported.scene.warnings:
+        if self.is_preview:   # Blender's preview scene: few samples, no reports
+            exported.scene.integrator = preview_integrator(exported.scene.integrator)
+        for warning in () if self.is_preview else exported.scene.warnings:
             self.report({"WARNING"}, warning)
         # The first render after installing compiles the numba kernels (cached afterwards).
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "
@@ -109,7 +114,8 @@ class MCEngine(bpy.types.RenderEngine):
         except Exception as exc:
             self._fail(_describe(exc, "preparing the renderer"), exc)
             return None, None
-        _store_effects(depsgraph.scene.original, session.features, exported.ignored)
+        if not self.is_preview:
+            _store_effects(depsgraph.scene.original, session.features, exported.ignored)
         return exported.scene, session
 
     def _publish(self, result, session, progress) -> None:
@@ -149,6 +155,8 @@ class MCEngine(bpy.types.RenderEngine):
 
     def _fail(self, message: str, exc: Exception) -> None:
         log.debug("MC Engine error", exc_info=exc)
+        if self.is_preview:   # a preview stays empty; the user's render reports the problem
+            return
         self.report({"ERROR"}, f"MC Engine: {message}")
         self.error_set(f"MC Engine: {message}")
 

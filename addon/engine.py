@@ -1,10 +1,13 @@
-"""The MC Engine render engine: F12 in Blender renders with mcengine.
+"""The MC Engine render engine: F12, previews and the viewport render with mcengine.
 
 ``render(depsgraph)`` exports the evaluated scene to a
 :class:`mcengine.scene.SceneDescription`, creates a render session and shows
 every progressive pass in the Render Result, with progress and statistics in
 the status bar.  Esc stops the render between passes (the session polls
-``test_break``) and keeps the partial image.
+``test_break``) and keeps the partial image.  Material, light and world
+previews go through ``render`` too, with the preview's sampling
+(``preview.py``).  The viewport's Rendered mode is ``view_update`` and
+``view_draw``, thin calls into ``viewport.py``.
 
 Errors never escape as tracebacks: an invalid scene or any failure becomes
 one ERROR report (and ``error_set``); unsupported features become one WARNING
@@ -20,10 +23,13 @@ import time
 import bpy
 import numpy as np
 
-from mcengine.scene import SceneError
+from mcengine.scene import Camera, SceneError
 
 from . import export
+from .export.camera import camera_from_view
+from .export.settings import unit_scale
 from .preview import preview_integrator
+from .viewport import ViewportRender, draw_frame, parts_to_export, status_line
 
 __all__ = ["ENGINE_ID", "MCEngine", "session_factory", "register", "unregister"]
 
@@ -51,7 +57,8 @@ last_render: dict = {}
 
 
 class MCEngine(bpy.types.RenderEngine):
-    """Final renders and material, light and world previews with mcengine."""
+    """Final renders, material, light and world previews, and the viewport's Rendered mode
+    with mcengine."""
 
     bl_idname = ENGINE_ID
     bl_label = "MC Engine"
@@ -84,6 +91,53 @@ class MCEngine(bpy.types.RenderEngine):
             self.end_result(result)
             if not self.is_preview:
                 self._record(depsgraph.scene.original, session)
+
+    # -- the 3D viewport's Rendered mode (viewport.py) -------------------------
+    def view_update(self, context, depsgraph):
+        """After an edit: export again what it changed (everything the first time)."""
+        render = self._viewport()
+        try:
+            render.update_scene(
+                lambda parts, previous: export.export(depsgraph, camera=Camera(), parts=parts,
+                                                      previous=previous),
+                parts_to_export(depsgraph.updates))
+        except Exception as exc:
+            log.debug("MC Engine viewport export failed", exc_info=exc)
+            render.export_failed(_describe(exc, "exporting the scene"))
+
+    def view_draw(self, context, depsgraph):
+        """Draw the newest image of the view's progressive render, restarting it if the view
+        or the scene changed; ask for another redraw while it renders."""
+        render = self._viewport()
+        scene = depsgraph.scene
+        region, view = context.region, context.region_data
+        scale = max(1, int(self.get_preview_pixel_size(scene)))
+        camera = camera_from_view(view.view_matrix, view.window_matrix, unit_scale(scene))
+        cycles = getattr(scene, "cycles", None)
+        frame = render.frame(camera, max(1, region.width // scale), max(1, region.height // scale),
+                             cycles.preview_samples if cycles is not None else 0)
+        if frame.image is not None:
+            draw_frame(self, scene, frame.image, region.width, region.height)
+        self.update_stats("", status_line(frame))
+        if frame.rendering:
+            self.tag_redraw()
+
+    def _viewport(self) -> ViewportRender:
+        render = getattr(self, "_mcengine_viewport", None)
+        if render is None:
+            # Looked up at each render, so that tests and the command line can replace it.
+            render = ViewportRender(lambda desc: session_factory(desc))
+            self._mcengine_viewport = render
+        return render
+
+    def __del__(self):
+        # Blender frees the engine (the viewport left Rendered mode): stop its render.
+        try:
+            render = getattr(self, "_mcengine_viewport", None)
+        except ReferenceError:      # the Blender side is already gone
+            return
+        if render is not None:
+            render.stop()
 
     # -- steps ---------------------------------------------------------------
     def _prepare(self, depsgraph):

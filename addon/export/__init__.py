@@ -25,7 +25,13 @@ from dataclasses import dataclass, field
 
 from mcengine.scene import SceneDescription, SceneError
 
-__all__ = ["ExportError", "ExportContext", "ExportResult", "export"]
+__all__ = ["ExportError", "ExportContext", "ExportResult", "PARTS", "export"]
+
+#: What :func:`export` can re-export on its own (the viewport, after an edit):
+#: "objects" (meshes and their materials), "materials" (the materials alone,
+#: when every object keeps its material slots), "lights", "world", "settings"
+#: (film and integrator).
+PARTS = frozenset({"objects", "materials", "lights", "world", "settings"})
 
 
 class ExportError(SceneError):
@@ -73,21 +79,65 @@ class ExportResult:
     ignored: list = field(default_factory=list)
 
 
-def export(depsgraph) -> ExportResult:
-    """Export everything the renderer needs from an evaluated render depsgraph.
+def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = None
+           ) -> ExportResult:
+    """Export everything the renderer needs from an evaluated depsgraph.
+
+    ``camera`` replaces the scene camera (the viewport's view).  With a
+    ``previous`` export, only ``parts`` (names of :data:`PARTS`) are exported
+    again and the rest is reused; materials alone are re-exported only if the
+    objects still use the same materials in the same order, else the objects
+    are exported too.
 
     Raises
     ------
     ExportError
         If the scene cannot be rendered at all (no camera, panoramic camera).
     """
-    from . import camera, lights, materials, mesh, settings, world
+    from . import camera as cameras
+    from . import settings, world
 
     scene = depsgraph.scene
     ctx = ExportContext(scene)
-    cam = camera.export_camera(ctx, depsgraph)  # first: it is the only fatal part
+    cam = camera if camera is not None else cameras.export_camera(ctx, depsgraph)  # may fail
+    old = previous.scene if previous is not None else None
+    parts = PARTS if old is None else set(parts)
+    if "materials" in parts and "objects" not in parts:
+        material_list = _materials_in_order(ctx, depsgraph)
+        if [m.name for m in material_list] != [m.name for m in old.materials]:
+            parts.add("objects")
+    if "objects" in parts:
+        geometry, material_list, walked_lights = _walk(ctx, depsgraph)
+    else:
+        geometry, walked_lights = old.geometry, None
+        if "materials" not in parts:
+            material_list = old.materials
+    if "lights" in parts:
+        light_list = walked_lights if walked_lights is not None else _walk(ctx, depsgraph,
+                                                                           meshes=False)[2]
+    else:
+        light_list = old.lights
+    desc = SceneDescription(
+        geometry=geometry,
+        materials=material_list,
+        lights=light_list,
+        camera=cam,
+        world=world.export_world(ctx, scene.world) if "world" in parts else old.world,
+        film=cameras.export_film(ctx, scene) if "settings" in parts else old.film,
+        integrator=(settings.export_integrator(ctx, scene, depsgraph.view_layer)
+                    if "settings" in parts else old.integrator),
+    )
+    desc.warnings = list(ctx.warnings)
+    return ExportResult(scene=desc, ignored=list(ctx.ignored))
+
+
+def _walk(ctx, depsgraph, meshes: bool = True):
+    """One pass over the instances: (geometry, materials, lights); geometry and materials
+    are None without ``meshes``."""
+    from . import lights, materials, mesh
+
     table = materials.MaterialTable(ctx)
-    meshes = mesh.MeshCollector(ctx, table)
+    collector = mesh.MeshCollector(ctx, table) if meshes else None
     light_list = []
     for inst in depsgraph.object_instances:
         if not inst.show_self:
@@ -98,21 +148,27 @@ def export(depsgraph) -> ExportResult:
                 light = lights.export_light(ctx, ob, inst.matrix_world.copy(), _instance_name(inst))
                 if light is not None:
                     light_list.append(light)
-            else:
-                meshes.add(inst, _instance_name(inst))
+            elif collector is not None:
+                collector.add(inst, _instance_name(inst))
         except Exception as exc:  # one bad object must not abort the render
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
-    desc = SceneDescription(
-        geometry=meshes.geometry(),
-        materials=table.materials,
-        lights=light_list,
-        camera=cam,
-        world=world.export_world(ctx, scene.world),
-        film=camera.export_film(ctx, scene),
-        integrator=settings.export_integrator(ctx, scene, depsgraph.view_layer),
-    )
-    desc.warnings = list(ctx.warnings)
-    return ExportResult(scene=desc, ignored=list(ctx.ignored))
+    if collector is None:
+        return None, None, light_list
+    return collector.geometry(), table.materials, light_list
+
+
+def _materials_in_order(ctx, depsgraph) -> list:
+    """The material table as the walk would build it, without reading any mesh."""
+    import bpy
+
+    from . import materials
+    table = materials.MaterialTable(ctx)
+    for inst in depsgraph.object_instances:
+        ob = inst.object
+        if inst.show_self and ob.type != "LIGHT" and isinstance(ob.data, bpy.types.Mesh):
+            for slot in ob.material_slots:
+                table.index(slot.material)
+    return table.materials
 
 
 def _instance_name(inst) -> str:

@@ -22,7 +22,7 @@ from mcengine.scene import Camera, Film
 from . import ExportError
 from .settings import cycles_settings
 
-__all__ = ["export_camera", "export_film", "frame_size", "border_region"]
+__all__ = ["export_camera", "camera_from_view", "export_film", "frame_size", "border_region"]
 
 
 def export_camera(ctx, depsgraph) -> Camera:
@@ -52,6 +52,39 @@ def export_camera(ctx, depsgraph) -> Camera:
         ortho_scale=float(cam.ortho_scale) * s,
         clip_start=float(cam.clip_start) * s,
         clip_end=float(cam.clip_end) * s,
+    )
+
+
+def camera_from_view(view_matrix, window_matrix, unit_scale: float = 1.0) -> Camera:
+    """The camera whose rays are those of a view and a projection matrix (the 3D viewport).
+
+    ``view_matrix`` maps world to view space (looking down -Z), ``window_matrix``
+    is the OpenGL projection of ``RegionView3D`` for the whole region (in the
+    camera view it includes the camera's zoom and offset).  The frustum at
+    unit distance, ``[l, r] x [b, t]``, gives a horizontally fitted camera:
+    half width ``1 / P[0][0]`` (perspective: sensor / (2 lens); orthographic:
+    half the orthographic scale) and shift ``(r + l) / (2 (r - l))`` of the
+    width, likewise for y; the clip distances come from the depth rows.
+    """
+    view = np.asarray(view_matrix, np.float64)
+    p = np.asarray(window_matrix, np.float64)
+    half_w, half_h = 1.0 / p[0, 0], 1.0 / p[1, 1]
+    ortho = p[3, 3] == 1.0
+    if ortho:
+        centre_x, centre_y = -p[0, 3] * half_w, -p[1, 3] * half_h
+        near, far = (p[2, 3] + 1.0) / p[2, 2], (p[2, 3] - 1.0) / p[2, 2]
+    else:
+        centre_x, centre_y = p[0, 2] * half_w, p[1, 2] * half_h
+        near, far = p[2, 3] / (p[2, 2] - 1.0), p[2, 3] / (p[2, 2] + 1.0)
+    sensor = 36.0
+    return Camera(
+        matrix_world=_without_scale(np.linalg.inv(view), unit_scale),
+        type="ORTHO" if ortho else "PERSP",
+        lens=sensor / (2.0 * half_w), sensor_width=sensor, sensor_height=sensor * half_h / half_w,
+        sensor_fit="HORIZONTAL",
+        shift_x=centre_x / (2.0 * half_w), shift_y=centre_y / (2.0 * half_w),
+        ortho_scale=2.0 * half_w * unit_scale,
+        clip_start=float(near) * unit_scale, clip_end=float(far) * unit_scale,
     )
 
 

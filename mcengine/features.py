@@ -79,7 +79,7 @@ SHARP_ROUGHNESS = 2e-10 ** 0.25
 
 
 def surface_kinds(material) -> set:
-    """The kinds of surface a material's graph can produce (its inputs are constants)."""
+    """The kinds of surface a material's graph can produce (a linked input may take any value)."""
     nodes, surface = material.graph()
     if surface is None:
         return set()
@@ -96,14 +96,25 @@ def surface_kinds(material) -> set:
                 todo.append(value.node)
 
         def get(name, default):
+            """The constant value of an input; None when something is linked to it."""
             value = inputs.get(name, default)
-            return default if isinstance(value, Link) else value
+            return None if isinstance(value, Link) else value
+
+        def positive(name, default):
+            """The input may be above 0 (a linked input may)."""
+            value = get(name, default)
+            return value is None or max(np.ravel(value)) > 0.0
+
+        def below_one(name, default):
+            value = get(name, default)
+            return value is None or float(value) < 1.0
 
         def sharp(name, default):
-            return float(get(name, default)) <= SHARP_ROUGHNESS
+            value = get(name, default)
+            return value is not None and float(value) <= SHARP_ROUGHNESS
         kind = node.type
         if kind == "BsdfDiffuse":
-            kinds.add("rough diffuse" if get("Roughness", 0.0) > 0.0 else "diffuse")
+            kinds.add("rough diffuse" if positive("Roughness", 0.0) else "diffuse")
         elif kind == "BsdfGlossy":
             kinds.add("sharp glossy" if sharp("Roughness", 0.5) else "rough glossy")
         elif kind == "BsdfGlass":
@@ -114,20 +125,19 @@ def surface_kinds(material) -> set:
             kinds.add({"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent",
                        "BsdfSheen": "sheen", "Emission": "emission", "Holdout": "holdout"}[kind])
         elif kind == "BsdfPrincipled":
-            metallic = float(get("Metallic", 0.0))
-            transmission = float(get("Transmission Weight", 0.0))
             rough = "sharp" if sharp("Roughness", 0.5) else "rough"
-            if (1 - metallic) * (1 - transmission) > 0 and max(get("Base Color", (0.8,) * 3)) > 0:
-                kinds.add("rough diffuse" if get("Diffuse Roughness", 0.0) > 0.0 else "diffuse")
-            if metallic > 0 or get("Specular IOR Level", 0.5) > 0:
+            if below_one("Metallic", 0.0) and below_one("Transmission Weight", 0.0) \
+                    and positive("Base Color", (0.8,) * 3):
+                kinds.add("rough diffuse" if positive("Diffuse Roughness", 0.0) else "diffuse")
+            if positive("Metallic", 0.0) or positive("Specular IOR Level", 0.5):
                 kinds.add(f"{rough} glossy")
-            if transmission > 0:
+            if positive("Transmission Weight", 0.0):
                 kinds.add(f"{rough} glass")
             for name, default, what in (("Coat Weight", 0.0, "coat"), ("Sheen Weight", 0.0, "sheen")):
-                if get(name, default) > 0:
+                if positive(name, default):
                     kinds.add(what)
-            if get("Alpha", 1.0) < 1.0:
+            if below_one("Alpha", 1.0):
                 kinds.add("transparent")
-            if get("Emission Strength", 0.0) > 0 and max(get("Emission Color", (1, 1, 1))) > 0:
+            if positive("Emission Strength", 0.0) and positive("Emission Color", (1, 1, 1)):
                 kinds.add("emission")
     return kinds

@@ -18,8 +18,9 @@ from .features import Features
 from .features import detect as detect_features
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
-from .kernels.lights import L_PMF, pack_lights
+from .kernels.lights import L_PMF, LIGHT_STRIDE, pack_lights
 from .kernels.sampling import filter_table
+from .kernels.shading import emission_estimates
 from .kernels.state import (
     CFG_CAUSTICS_REFLECTIVE,
     CFG_CAUSTICS_REFRACTIVE,
@@ -47,11 +48,24 @@ from .kernels.state import (
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     FCFG_SIZE,
+    MF_EMISSION_VARIES,
     MF_EMISSIVE,
     SceneData,
+    alloc_scratch,
+)
+from .kernels.svm import (
+    OBJ_COLOR,
+    OBJ_INVERSE,
+    OBJ_MATRIX,
+    OBJ_PASS_INDEX,
+    OBJ_RANDOM,
+    OBJ_STRIDE,
+    OBJ_TEXSPACE_LOC,
+    OBJ_TEXSPACE_SIZE,
+    TextureData,
 )
 from .scene import SceneDescription
-from .shaders import ShaderTable
+from .shaders import AttributeLayout, ShaderTable
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
@@ -85,14 +99,37 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
         hi = np.maximum(hi, np.max(lamp_pos, axis=0))
     scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
 
-    shaders = ShaderTable(scene.materials)
+    layout, attr = pack_attributes(g)
+    shaders = ShaderTable(scene.materials, layout)
     mat_index = np.ascontiguousarray(g.material_index, np.int32)
+    film = scene.film
+    camera = pack_camera(scene.camera, film)
+    none_f, none_i = np.zeros(0), np.zeros(0, np.int32)
+    sc = SceneData(
+        verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
+        mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
+        mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
+        lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
+        emit_cdf=np.zeros(1), emit_group=np.zeros(5), tri_light=np.full(len(tris), -1, np.int32),
+        tri_area=tri_area, tri_normal=tri_normal,
+        world=np.asarray(scene.world.color, np.float64).reshape(3), camera=camera,
+        filter_table=filter_table(film.filter_type, film.filter_width),
+        tex=TextureData(attr=attr, tri_object=np.ascontiguousarray(g.object_index, np.int32),
+                        objects=pack_objects(g), camera=camera))
+
+    # Lights: lamps, and the triangles of emissive materials.
     if len(tris):
         emissive = ((shaders.flags[mat_index] & MF_EMISSIVE) != 0) & (tri_area > 0.0)
     else:
         emissive = np.zeros(0, bool)
     emit_tri = np.flatnonzero(emissive).astype(np.int32)
-    emit_power = shaders.emission[mat_index[emit_tri]].mean(axis=1) * math.pi * tri_area[emit_tri]
+    radiance = shaders.emission[mat_index[emit_tri]]
+    varies = (shaders.flags[mat_index[emit_tri]] & MF_EMISSION_VARIES) != 0
+    if np.any(varies):
+        estimates = np.zeros((int(varies.sum()), 3))
+        emission_estimates(sc, alloc_scratch(sc), emit_tri[varies], estimates)
+        radiance[varies] = np.maximum(estimates, 0.0)
+    emit_power = radiance.mean(axis=1) * math.pi * tri_area[emit_tri]
     tri_light = np.full(len(tris), -1, np.int32)
     tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
 
@@ -113,19 +150,9 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
     feats = detect_features(scene, len(emit_tri), lamp_power, shaders.flags)
-
-    film = scene.film
     x0, y0, x1, y1 = film.window
-    world = np.asarray(scene.world.color, np.float64).reshape(3)
-    sc = SceneData(
-        verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
-        mat_index=mat_index, svm_ops=shaders.ops, svm_consts=shaders.consts,
-        mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
-        lamps=lamps,
-        light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf, emit_cdf=emit_cdf,
-        emit_group=emit_group, tri_light=tri_light,
-        tri_area=tri_area, tri_normal=tri_normal, world=world, camera=pack_camera(scene.camera, film),
-        filter_table=filter_table(film.filter_type, film.filter_width))
+    sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,
+                     emit_cdf=emit_cdf, emit_group=emit_group, tri_light=tri_light)
 
     it = scene.integrator
     cfg = np.zeros(CFG_SIZE, np.int64)
@@ -158,3 +185,33 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
     cfg[CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
     return PackedScene(sc, cfg, fcfg, feats)
+
+
+def pack_attributes(g) -> tuple[AttributeLayout, np.ndarray]:
+    """The per-corner attributes as one (T, 3, S) float32 array: the default UV map first
+    (``svm.ATTR_DEFAULT_UV``), then every named attribute; and where each one lives."""
+    layout = AttributeLayout()
+    columns = [np.asarray(g.uvs, np.float32).reshape(-1, 3, 2)]
+    offset = 2
+    for name, a in g.attributes.items():
+        a = np.asarray(a, np.float32)
+        layout.offsets[name] = (offset, a.shape[2])
+        columns.append(a)
+        offset += a.shape[2]
+    return layout, np.ascontiguousarray(np.concatenate(columns, axis=2))
+
+
+def pack_objects(g) -> np.ndarray:
+    """Per-object data for the shader nodes (``svm.OBJ_*`` columns)."""
+    matrix, texspace, info = g.object_arrays()
+    o = matrix.shape[0]
+    out = np.zeros((max(o, 1), OBJ_STRIDE))
+    if o:
+        out[:o, OBJ_MATRIX:OBJ_MATRIX + 12] = matrix[:, :3, :].reshape(o, 12)
+        out[:o, OBJ_INVERSE:OBJ_INVERSE + 12] = np.linalg.inv(matrix)[:, :3, :].reshape(o, 12)
+        out[:o, OBJ_TEXSPACE_LOC:OBJ_TEXSPACE_LOC + 3] = texspace[:, 0]
+        out[:o, OBJ_TEXSPACE_SIZE:OBJ_TEXSPACE_SIZE + 3] = texspace[:, 1]
+        out[:o, OBJ_RANDOM] = info[:, 0]
+        out[:o, OBJ_PASS_INDEX] = info[:, 1]
+        out[:o, OBJ_COLOR:OBJ_COLOR + 4] = info[:, 2:6]
+    return out

@@ -38,7 +38,7 @@ LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
 MAX_RESOLUTION = 65536          # pixels per side, Blender's own limit
 MAX_SAMPLES = 1 << 24           # Cycles' limit
 MAX_BOUNCES = 1024
-MIN_FILTER_WIDTH = 0.01         # pixels, Blender's own limit
+MIN_FILTER_WIDTH = float(np.float32(0.01))   # pixels, Blender's own limit (stored as float32)
 PI_FLOAT32 = float(np.float32(np.pi))
 AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
@@ -58,6 +58,16 @@ class Geometry:
     uvs             (T, 3, 2) float32  UV at each corner (zeros if the mesh has none)
     material_index  (T,) int32      index into ``SceneDescription.materials``
     object_index    (T,) int32      index into ``object_names`` (for messages)
+    attributes      name -> (T, 3, C) float32  per-corner attributes the shader nodes read by
+                    name (UV maps, colour attributes, 1 <= C <= 4); ``uvs`` is the default UV map
+
+    Per object (O = len(object_names)), optional: when absent, an object has the identity
+    matrix, the bounding box of its triangles as texture space and zero Object Info.
+
+    object_matrix   (O, 4, 4) float64  object -> world (world units)
+    object_texspace (O, 2, 3) float64  generated texture space: centre and half-size
+                    (object space; Blender's texspace_location and texspace_size)
+    object_info     (O, 6) float64     Object Info: random, pass index, colour RGBA
     """
 
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
@@ -67,6 +77,38 @@ class Geometry:
     material_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     object_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     object_names: list = field(default_factory=list)
+    attributes: dict = field(default_factory=dict)
+    object_matrix: np.ndarray | None = None
+    object_texspace: np.ndarray | None = None
+    object_info: np.ndarray | None = None
+
+    @property
+    def num_objects(self) -> int:
+        return len(self.object_names)
+
+    def object_arrays(self) -> tuple:
+        """(object_matrix, object_texspace, object_info), the defaults filled in."""
+        o = self.num_objects
+        matrix = (np.broadcast_to(np.eye(4), (o, 4, 4)).copy() if self.object_matrix is None
+                  else np.asarray(self.object_matrix, np.float64))
+        info = np.zeros((o, 6)) if self.object_info is None else np.asarray(self.object_info, np.float64)
+        if self.object_texspace is not None:
+            return matrix, np.asarray(self.object_texspace, np.float64), info
+        texspace = np.zeros((o, 2, 3))
+        texspace[:, 1] = 1.0
+        if self.num_triangles:
+            corners = self.vertices[self.triangles].astype(np.float64)      # (T, 3, 3)
+            inverse = np.linalg.inv(matrix)
+            obj = np.clip(self.object_index, 0, max(o - 1, 0))
+            local = np.einsum("tij,tkj->tki", inverse[obj, :3, :3], corners) + inverse[obj, None, :3, 3]
+            lo = np.full((o, 3), np.inf)
+            hi = np.full((o, 3), -np.inf)
+            np.minimum.at(lo, obj, local.min(axis=1))
+            np.maximum.at(hi, obj, local.max(axis=1))
+            seen = np.isfinite(lo[:, 0])
+            texspace[seen, 0] = 0.5 * (lo[seen] + hi[seen])
+            texspace[seen, 1] = 0.5 * (hi[seen] - lo[seen])
+        return matrix, auto_texspace_size(texspace), info
 
     @property
     def num_triangles(self) -> int:
@@ -98,10 +140,26 @@ class Geometry:
 
     @staticmethod
     def concatenate(parts) -> "Geometry":
-        """Join several geometries (object indices and names are merged)."""
+        """Join several geometries (object indices, names, data and attributes are merged;
+        an attribute some part lacks is zero there)."""
         parts = [g for g in parts if g.num_triangles]
         if not parts:
             return Geometry()
+        sizes = {}
+        for g in parts:
+            for name, a in g.attributes.items():
+                sizes[name] = max(sizes.get(name, 0), a.shape[2])
+        attributes = {}
+        for name, size in sizes.items():
+            columns = []
+            for g in parts:
+                a = g.attributes.get(name)
+                full = np.zeros((g.num_triangles, 3, size), np.float32)
+                if a is not None:
+                    full[:, :, :a.shape[2]] = a
+                columns.append(full)
+            attributes[name] = np.concatenate(columns)
+        objects = [g.object_arrays() for g in parts]
         verts, tris, names, objs = [], [], [], []
         v_off = 0
         for g in parts:
@@ -115,7 +173,20 @@ class Geometry:
             normals=np.concatenate([g.normals for g in parts]),
             uvs=np.concatenate([g.uvs for g in parts]),
             material_index=np.concatenate([g.material_index for g in parts]),
-            object_index=np.concatenate(objs), object_names=names)
+            object_index=np.concatenate(objs), object_names=names, attributes=attributes,
+            object_matrix=np.concatenate([o[0] for o in objects]),
+            object_texspace=np.concatenate([o[1] for o in objects]),
+            object_info=np.concatenate([o[2] for o in objects]))
+
+
+def auto_texspace_size(texspace: np.ndarray) -> np.ndarray:
+    """Blender's rule for a texture space's half-size: 0 becomes 1, tiny ones +-1e-5."""
+    out = np.array(texspace, np.float64)
+    size = out[..., 1, :]
+    size[size == 0.0] = 1.0
+    tiny = np.abs(size) < 1e-5
+    size[tiny] = np.where(size[tiny] < 0, -1e-5, 1e-5)
+    return out
 
 
 @dataclass(frozen=True)
@@ -346,6 +417,25 @@ class SceneDescription:
         for name in ("vertices", "normals", "uvs"):
             if not np.all(np.isfinite(getattr(g, name))):
                 raise SceneError(f"geometry.{name} contains NaN or infinite values")
+        for name, a in g.attributes.items():
+            a = np.asarray(a)
+            if not isinstance(name, str) or a.ndim != 3 or a.shape[:2] != (t, 3) or not 1 <= a.shape[2] <= 4:
+                raise SceneError(f"geometry attribute {name!r} has shape {a.shape}, expected ({t}, 3, 1..4)")
+            if not np.all(np.isfinite(a)):
+                raise SceneError(f"geometry attribute {name!r} contains NaN or infinite values")
+        o = g.num_objects
+        if t and (g.object_index.min() < 0 or g.object_index.max() >= max(o, 1)):
+            raise SceneError("geometry.object_index refers to an object that does not exist")
+        for name, shape in (("object_matrix", (o, 4, 4)), ("object_texspace", (o, 2, 3)),
+                            ("object_info", (o, 6))):
+            a = getattr(g, name)
+            if a is None:
+                continue
+            if np.shape(a) != shape or not np.all(np.isfinite(a)):
+                raise SceneError(f"geometry.{name} must be finite with shape {shape}")
+        if g.object_matrix is not None and o and np.any(
+                np.abs(np.linalg.det(np.asarray(g.object_matrix)[:, :3, :3])) < 1e-300):
+            raise SceneError("geometry.object_matrix has a singular matrix (an object scaled to 0)")
         if t and (g.material_index.min() < 0 or g.material_index.max() >= len(self.materials)):
             raise SceneError("geometry.material_index refers to a material that does not exist")
         if not self.materials:
@@ -426,9 +516,13 @@ class SceneDescription:
             "integrator": dataclasses.asdict(self.integrator),
             "warnings": list(self.warnings),
         }
+        matrix, texspace, info = g.object_arrays()
+        meta["attributes"] = list(g.attributes)
+        attributes = {f"attribute{k}": a for k, a in enumerate(g.attributes.values())}
         np.savez_compressed(
             path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
+            object_matrix=matrix, object_texspace=texspace, object_info=info, **attributes,
             meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
 
     @staticmethod
@@ -457,24 +551,35 @@ class SceneDescription:
             raise SceneError(f"{path}: {exc}") from None
 
 
-# Arrays of a saved scene: name -> (dtype kind, trailing shape).
+# Arrays of a saved scene: name -> (dtype kind, trailing shape); optional ones (files saved
+# before 0.3 lack them), and attributes "attribute<k>" of trailing shape (3, C).
 _SAVED_ARRAYS = {
     "vertices": ("f", (3,)), "triangles": ("iu", (3,)), "normals": ("f", (3, 3)),
     "uvs": ("f", (3, 2)), "material_index": ("iu", ()), "object_index": ("iu", ()),
     "meta": ("u", ()),
 }
+_OPTIONAL_ARRAYS = {"object_matrix": ("f", (4, 4)), "object_texspace": ("f", (2, 3)),
+                    "object_info": ("f", (6,))}
 MAX_META_BYTES = 64 << 20
 
 
 def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
     """The saved arrays, after checking every header (dtype, shape, total size)."""
     headers = {}
-    for name, (kinds, trailing) in _SAVED_ARRAYS.items():
+    present = {name[:-4] for name in archive.namelist() if name.endswith(".npy")}
+    expected = dict(_SAVED_ARRAYS)
+    expected.update({n: spec for n, spec in _OPTIONAL_ARRAYS.items() if n in present})
+    for name in present:
+        if name.startswith("attribute"):
+            expected[name] = ("f", None)
+    for name, (kinds, trailing) in expected.items():
         with archive.open(f"{name}.npy") as f:
             version = np.lib.format.read_magic(f)
             read_header = (np.lib.format.read_array_header_1_0 if version == (1, 0)
                            else np.lib.format.read_array_header_2_0)
             shape, _fortran, dtype = read_header(f)
+        if trailing is None and len(shape) == 3 and shape[1] == 3:   # an attribute: (T, 3, C)
+            trailing = tuple(shape[1:])
         if dtype.kind not in kinds or dtype.hasobject or tuple(shape[1:]) != trailing \
                 or len(shape) != 1 + len(trailing):
             raise SceneError(f"{path}: array {name!r} has dtype {dtype} and shape {shape}")
@@ -487,14 +592,18 @@ def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
         raise SceneError(f"{path}: its arrays need {total / memory.GIB:.2f} GiB once decompressed, "
                          f"more than half the {free / memory.GIB:.2f} GiB of memory available")
     with np.load(path, allow_pickle=False) as z:
-        return {name: z[name] for name in _SAVED_ARRAYS}
+        return {name: z[name] for name in expected}
 
 
 def _from_saved(z: dict, meta: dict) -> "SceneDescription":
     """Build the description from the arrays and the JSON metadata of a saved file."""
+    names = list(meta.get("attributes", []))
     geom = Geometry(vertices=z["vertices"], triangles=z["triangles"], normals=z["normals"],
                     uvs=z["uvs"], material_index=z["material_index"],
-                    object_index=z["object_index"], object_names=list(meta["object_names"]))
+                    object_index=z["object_index"], object_names=list(meta["object_names"]),
+                    attributes={str(name): z[f"attribute{k}"] for k, name in enumerate(names)},
+                    object_matrix=z.get("object_matrix"), object_texspace=z.get("object_texspace"),
+                    object_info=z.get("object_info"))
     lights = []
     for d in meta["lights"]:
         d = dict(d)

@@ -152,7 +152,6 @@ class _Buffers:
         self.key = (batch, classic)
         self.state = alloc_path_state(batch)
         self.shadow = alloc_shadow_queue(batch)
-        self.scratch = alloc_scratch()
         if classic:   # a second generation of rays and per-camera-sample sums
             self.next_state = alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
@@ -162,11 +161,11 @@ class _Buffers:
     def bytes_for(batch, classic) -> int:
         """Memory of one worker's buffers for ``batch`` paths (without allocating them)."""
         one, two = _Buffers(1, classic).nbytes, _Buffers(2, classic).nbytes
-        return (two - one) * batch + (2 * one - two)     # per path, plus the fixed scratch
+        return (two - one) * batch + (2 * one - two)     # per path, plus the fixed part
 
     @property
     def nbytes(self) -> int:
-        arrays = [*self.state, *self.shadow, *self.scratch]
+        arrays = [*self.state, *self.shadow]
         if self.key[1]:
             arrays += [*self.next_state, self.acc, self.root_pixel]
         return sum(a.nbytes for a in arrays)
@@ -189,8 +188,9 @@ class _Buffers:
 class _Worker:
     """One worker thread's buffers, counters and timers for one render."""
 
-    def __init__(self, buffers, accel):
+    def __init__(self, buffers, accel, sc):
         self.buffers = buffers
+        self.scratch = alloc_scratch(sc)       # closures and shader registers of this scene
         self.stats = np.zeros(ST_SIZE, np.int64)
         self.embree_clock = [0.0]
         self.busy = 0.0
@@ -371,9 +371,10 @@ class RenderSession:
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(_Buffers.take(self.batch_size, self._classic), self.accel)
+            w = _Worker(_Buffers.take(self.batch_size, self._classic), self.accel, self.sc)
             self._workers.w = w
-            self._buffer_bytes = max(self._buffer_bytes, self.threads * w.buffers.nbytes)
+            scratch = sum(a.nbytes for a in w.scratch)
+            self._buffer_bytes = max(self._buffer_bytes, self.threads * (w.buffers.nbytes + scratch))
             with self._lock:
                 self._all_workers.append(w)
         return w
@@ -382,11 +383,11 @@ class RenderSession:
         b = w.buffers
         if not self._classic:
             path.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
-                             b.scratch, film, w.stats)
+                             w.scratch, film, w.stats)
         else:
             classic.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
                                         (b.state, b.next_state, b.shadow, b.acc, b.root_pixel,
-                                         b.scratch),
+                                         w.scratch),
                                         film, w.stats, self.code, self.depth, self.branching)
 
     def _trace(self, pixels, spp):
@@ -400,7 +401,7 @@ class RenderSession:
     def _warm_up(self):
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
         size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self._classic else 64
-        self._trace_with(_Worker(_Buffers(size, self._classic), self.accel),
+        self._trace_with(_Worker(_Buffers(size, self._classic), self.accel, self.sc),
                          np.zeros(1, np.int32), 1, Film(1, 1).arrays)
 
     def _update_stats(self, t_start):

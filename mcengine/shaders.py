@@ -5,17 +5,29 @@ compiler walks it from the output's Surface socket, as Cycles' SVM compiler
 does (scene/shader_graph.cpp, svm.cpp), and emits a straight-line program for
 ``kernels.svm.eval_shader``:
 
-* every closure node (Principled, Diffuse, Glossy, ...) gets a block of
-  registers holding its inputs in the order of ``kernels.svm.nodes``, filled
-  by one ``OP_CONST`` from the constant pool, and an ``OP_CLOSURE`` that
-  builds its closures at the shading point;
-* a Mix Shader computes the weights of its two inputs from its factor
-  (``OP_MIX_WEIGHT``: in x (1 - fac) and in x fac), an Add Shader passes its
-  weight to both; a closure node's weight register holds the product of the
-  factors on its way to the output (none: weight 1).
+* every node reached gets a block of registers holding its inputs in the
+  order of ``kernels.svm.nodes``; constant inputs are written there once per
+  render (``ShaderTable.registers``), a linked input is copied (``OP_COPY``)
+  or converted (``OP_CONVERT``: colour -> float is the luminance, vector ->
+  float the mean, float -> vector or colour (f, f, f)) from its source's
+  output registers before the node runs;
+* a value node (textures, maths, coordinates) runs once per point however
+  many inputs it feeds (``OP_NODE``) and writes its outputs to registers;
+  a node whose inputs are all constant and that reads nothing of the point
+  is evaluated here, ahead of time, and becomes constants (constant folding);
+  a texture's unlinked Vector input gets the coordinate Cycles uses (a
+  Texture Coordinate node's Generated or UV output);
+* a closure node builds its closures (``OP_CLOSURE``); a Mix Shader computes
+  the weights of its two inputs from its factor (``OP_MIX_WEIGHT``: in x
+  (1 - fac) and in x fac), an Add Shader passes its weight to both; a closure
+  node's weight register holds the product of the factors on its way to the
+  output (none: weight 1).
 
 Programs are plain int32/float64 arrays, so a saved scene renders without
-Blender and the kernels see one format for every material.
+Blender and the kernels see one format for every material.  Attributes are
+found by name in an :class:`AttributeLayout` (the scene's per-corner
+attributes: UV maps, colour attributes); a missing one reads as zeros, as in
+Cycles.
 """
 from __future__ import annotations
 
@@ -23,131 +35,365 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .kernels.camera import CAMERA_PARAMS
 from .kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
-from .kernels.state import MF_BUMP_CORRECTION, MF_EMISSIVE, MF_TRANSPARENT
-from .kernels.svm import MAX_REGS, OP_CLOSURE, OP_CONST, OP_MIX_WEIGHT, ShadingData, eval_shader
-from .kernels.svm.nodes import DISTRIBUTIONS, INPUTS, KIND, SHADER_ROUTING
-from .scene import Link, Material, SceneError
+from .kernels.state import MF_BUMP_CORRECTION, MF_EMISSION_VARIES, MF_EMISSIVE, MF_TRANSPARENT
+from .kernels.svm import (
+    CONV_COLOR_TO_FLOAT,
+    CONV_FLOAT_TO_VECTOR,
+    CONV_VECTOR_TO_FLOAT,
+    MAX_REGS,
+    OBJ_STRIDE,
+    OP_CLOSURE,
+    OP_CONVERT,
+    OP_COPY,
+    OP_MIX_WEIGHT,
+    OP_NODE,
+    RGB_TO_Y,
+    ShadingData,
+    TextureData,
+    eval_node,
+    eval_shader,
+)
+from .kernels.svm.nodes import (
+    CLOSURES,
+    COLOR,
+    ENUMS,
+    FLOAT,
+    IMPLICIT,
+    MATRIX,
+    SHADER,
+    SHADER_ROUTING,
+    SIZE,
+    TABLE,
+    VALUE_NODES,
+    VECTOR,
+)
+from .scene import Link, Material, SceneError, ShaderNode
 
-__all__ = ["Program", "compile_material", "ShaderTable"]
+__all__ = ["AttributeLayout", "Program", "compile_material", "ShaderTable"]
 
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
+# Inputs whose constant values decide whether a closure node can emit or let light through.
+_EMISSION_INPUTS = {"Emission": ("Color", "Strength"),
+                    "BsdfPrincipled": ("Emission Color", "Emission Strength")}
+_TRANSPARENCY_INPUTS = {"BsdfTransparent": ("Color",), "BsdfPrincipled": ("Alpha",)}
+
+
+@dataclass
+class AttributeLayout:
+    """Where each per-corner attribute lives in the packed attribute array.
+
+    ``offsets`` maps an attribute name to (first component, component count);
+    the default UV map is at offset 0 under the name "" (two components).
+    """
+
+    offsets: dict = field(default_factory=lambda: {"": (0, 2)})
+
+    def find(self, name: str) -> tuple[int, int]:
+        """(offset, size) of an attribute; (-1, 0) when the scene has none of that name."""
+        return self.offsets.get(name, (-1, 0))
+
+
+@dataclass
+class Value:
+    """A socket's value at compile time: constants, or registers filled at run time."""
+
+    type: str
+    const: tuple | None = None     # the components when constant
+    reg: int = -1                  # first register otherwise
+
+    @property
+    def constant(self) -> bool:
+        return self.const is not None
 
 
 @dataclass
 class Program:
-    """The compiled form of one material."""
+    """The compiled form of one material: rows, and the constants of its registers."""
 
+    base: int = 0                                  # first register of this material
     ops: list = field(default_factory=list)        # [op, a, b, c] rows
-    consts: list = field(default_factory=list)     # float constants
+    init: dict = field(default_factory=dict)       # register -> constant
     registers: int = 0                             # registers used
+    emission_varies: bool = False                  # some emission input is not constant
+    transparency_varies: bool = False              # some transparency input is not constant
 
     def reg(self, n: int) -> int:
         """Allocate n consecutive registers; returns the first."""
-        first = self.registers
+        first = self.base + self.registers
         self.registers += n
-        if self.registers > MAX_REGS:
-            raise SceneError(f"shader needs more than {MAX_REGS} registers")
+        if self.base + self.registers > MAX_REGS:
+            raise SceneError(f"the scene's shaders need more than {MAX_REGS} registers")
+        return first
+
+    def store(self, values) -> int:
+        """Registers holding constants; returns the first."""
+        values = [float(v) for v in values]
+        first = self.reg(len(values))
+        for k, v in enumerate(values):
+            self.init[first + k] = v
         return first
 
 
-def compile_material(material: Material) -> Program:
-    """Compile ``material`` (SceneError names an unsupported node or a cycle)."""
-    nodes, surface = material.graph()
-    program = Program()
-    if surface is not None:
-        _compile_shader(material, nodes, surface, NO_WEIGHT, program, ())
-    return program
+def compile_material(material: Material, attributes: AttributeLayout | None = None,
+                     base: int = 0) -> Program:
+    """Compile ``material`` from register ``base`` on (SceneError names an unsupported node,
+    a bad link or a cycle)."""
+    return _Compiler(material, attributes or AttributeLayout(), base).compile()
 
 
-def _compile_shader(material, nodes, link: Link, weight_reg: int, program: Program, path: tuple):
-    if link.node in path:
-        raise SceneError(f"material '{material.name}': its shader graph has a cycle")
-    node = nodes[link.node]
-    path = path + (link.node,)
-    if node.type in SHADER_ROUTING:
-        first = node.inputs.get("Shader")
-        second = node.inputs.get("Shader_001")
-        if node.type == "MixShader":
-            fac = _constant(material, node, "Fac", 0.5)
-            fac_reg = program.reg(1)
-            _load(program, fac_reg, [fac])
-            out = program.reg(2)
-            program.ops.append([OP_MIX_WEIGHT, fac_reg, weight_reg, out])
-            weights = (out, out + 1)
+class _Compiler:
+    def __init__(self, material: Material, attributes: AttributeLayout, base: int):
+        self.material = material
+        self.nodes, self.surface = material.graph()
+        self.attributes = attributes
+        self.program = Program(base=base)
+        self.outputs: dict[int, dict] = {}       # value node -> its outputs (name -> Value)
+        self.implicit: dict[str, Value] = {}     # texture coordinates inserted for unlinked inputs
+        self.path: tuple = ()
+
+    def compile(self) -> Program:
+        if self.surface is not None:
+            self.shader(self.surface, NO_WEIGHT)
+        return self.program
+
+    def error(self, message: str) -> SceneError:
+        return SceneError(f"material '{self.material.name}': {message}")
+
+    # -- closures ---------------------------------------------------------------------------------
+    def shader(self, link: Link, weight_reg: int) -> None:
+        node = self.node(link)
+        if node.type in SHADER_ROUTING:
+            self.path += (link.node,)
+            if node.type == "MixShader":
+                fac = self.input(node, SHADER_ROUTING["MixShader"].inputs[0])
+                fac_reg = fac.reg if not fac.constant else self.program.store(fac.const)
+                out = self.program.reg(2)
+                self.program.ops.append([OP_MIX_WEIGHT, fac_reg, weight_reg, out])
+                weights = (out, out + 1)
+            else:
+                weights = (weight_reg, weight_reg)
+            for name, w in zip(("Shader", "Shader_001"), weights):
+                shader_in = node.inputs.get(name)
+                if isinstance(shader_in, Link):
+                    self.shader(shader_in, w)
+            self.path = self.path[:-1]
+            return
+        spec = CLOSURES.get(node.type)
+        if spec is None:
+            if node.type in VALUE_NODES:
+                raise self.error(f"the output of {node.type} is not a shader")
+            raise self.error(f"shader node {node.type} is not supported")
+        values = [self.input(node, socket) for socket in spec.inputs]
+        base = self.block(spec.inputs, values)
+        self.program.ops.append([OP_CLOSURE, spec.code, base, weight_reg])
+        for name, value in zip((s.name for s in spec.inputs), values):
+            if not value.constant:
+                if name in _EMISSION_INPUTS.get(node.type, ()):
+                    self.program.emission_varies = True
+                if name in _TRANSPARENCY_INPUTS.get(node.type, ()):
+                    self.program.transparency_varies = True
+
+    # -- values -----------------------------------------------------------------------------------
+    def node(self, link: Link):
+        if link.node in self.path:
+            raise self.error("its shader graph has a cycle")
+        return self.nodes[link.node]
+
+    def input(self, node, socket) -> Value:
+        """The value an input receives: its link's (converted), or its constant."""
+        value = node.inputs.get(socket.name, socket.default)
+        if isinstance(value, Link):
+            return self.converted(self.output(value), socket.type)
+        if socket.name.startswith("prop:"):
+            return Value(socket.type, self.prop(node, socket))
+        if isinstance(value, str):      # an implicit texture coordinate
+            return self.coordinate(IMPLICIT[value])
+        return Value(socket.type, self.constant(node, socket, value))
+
+    def constant(self, node, socket, value) -> tuple:
+        size = SIZE[socket.type]
+        flat = np.asarray(value, float).ravel()
+        if flat.size == 0:
+            raise self.error(f"input '{socket.name}' of {node.type} has no value")
+        return tuple(np.broadcast_to(flat[:size], (size,)).tolist())
+
+    def prop(self, node, socket) -> tuple:
+        """A property as register values (``nodes`` module docstring)."""
+        name = socket.name[5:]
+        value = node.props.get(name, socket.default)
+        if socket.type == TABLE:
+            flat = [float(v) for v in np.asarray(value, float).ravel()]
+            return (float(len(flat)), *flat)
+        if socket.type == MATRIX:
+            flat = np.asarray(value, float).ravel()
+            if flat.size != 12:
+                raise self.error(f"property '{name}' of {node.type} is not a 3 x 4 matrix")
+            return tuple(flat.tolist())
+        if isinstance(value, str):
+            codes = ENUMS.get(name, {})
+            if value not in codes:
+                raise self.error(f"{node.type} {name} '{value}' is not supported")
+            return (float(codes[value]),)
+        return self.constant(node, socket, value)
+
+    def output(self, link: Link) -> Value:
+        """The value of a node's output socket (the node is compiled once)."""
+        node = self.node(link)
+        spec = VALUE_NODES.get(node.type)
+        if spec is None:
+            if node.type in CLOSURES or node.type in SHADER_ROUTING:
+                raise self.error(f"a shader output ({node.type}) is linked to a value input")
+            raise self.error(f"node {node.type} is not supported")
+        if link.node not in self.outputs:
+            self.path += (link.node,)
+            self.outputs[link.node] = self.evaluate(node, spec)
+            self.path = self.path[:-1]
+        outputs = self.outputs[link.node]
+        if link.socket not in outputs:
+            raise self.error(f"{node.type} has no output '{link.socket}'")
+        return outputs[link.socket]
+
+    def coordinate(self, name: str) -> Value:
+        """The Texture Coordinate output ``name`` (one node per material)."""
+        if "TexCoord" not in self.implicit:
+            self.implicit["TexCoord"] = self.evaluate(ShaderNode("TexCoord"), VALUE_NODES["TexCoord"])
+        return self.implicit["TexCoord"][name]
+
+    def evaluate(self, node, spec) -> dict:
+        """Compile value node ``node`` (or fold it); its outputs by name."""
+        values = [self.input(node, socket) for socket in spec.inputs]
+        if node.type == "Attribute" or node.type == "UVMap":
+            values = self.attribute_inputs(node, spec, values)
+        if spec.pure and all(v.constant for v in values):
+            return self.fold(spec, values)
+        base = self.block(spec.inputs, values)
+        out = self.program.reg(sum(SIZE[s.type] for s in spec.outputs))
+        self.program.ops.append([OP_NODE, spec.code, base, out])
+        outputs, k = {}, out
+        for socket in spec.outputs:
+            outputs[socket.name] = Value(socket.type, reg=k)
+            k += SIZE[socket.type]
+        return outputs
+
+    def attribute_inputs(self, node, spec, values) -> list:
+        """The attribute a UV Map or Attribute node reads, found by name."""
+        name = str(node.props.get("attribute_name" if node.type == "Attribute" else "uv_map", ""))
+        offset, size = self.attributes.find(name)
+        names = [s.name for s in spec.inputs]
+        values[names.index("prop:attribute")] = Value(FLOAT, (float(offset),))
+        if "prop:attribute_size" in names:
+            values[names.index("prop:attribute_size")] = Value(FLOAT, (float(size),))
+        return values
+
+    def fold(self, spec, values) -> dict:
+        """Evaluate a pure node with constant inputs now, with the kernels' own code."""
+        regs = np.concatenate([np.asarray(v.const, float) for v in values] + [np.zeros(64)])
+        out = sum(len(v.const) for v in values)
+        eval_node(spec.code, regs, 0, out, _HOST_POINT, _NO_TEXTURES)
+        outputs, k = {}, out
+        for socket in spec.outputs:
+            n = SIZE[socket.type]
+            outputs[socket.name] = Value(socket.type, tuple(regs[k:k + n].tolist()))
+            k += n
+        return outputs
+
+    def block(self, sockets, values) -> int:
+        """Registers for a node's inputs: constants stored, linked values copied in."""
+        sizes = [len(v.const) if v.constant else SIZE[s.type] for s, v in zip(sockets, values)]
+        base = self.program.reg(sum(sizes))
+        k = base
+        for value, n in zip(values, sizes):
+            if value.constant:
+                for j, c in enumerate(value.const):
+                    self.program.init[k + j] = float(c)
+            else:
+                self.program.ops.append([OP_COPY, k, value.reg, n])
+            k += n
+        return base
+
+    def converted(self, value: Value, to: str) -> Value:
+        """``value`` as socket type ``to`` (Cycles' implicit conversions)."""
+        frm = value.type
+        if frm == to or {frm, to} <= {COLOR, VECTOR} or to in (TABLE, MATRIX):
+            return Value(to, value.const, value.reg)
+        if frm == SHADER or to == SHADER:
+            raise self.error("a shader output is linked to a value input")
+        if to == FLOAT:
+            kind = CONV_COLOR_TO_FLOAT if frm == COLOR else CONV_VECTOR_TO_FLOAT
+            if value.constant:
+                c = value.const
+                f = (sum(w * x for w, x in zip(RGB_TO_Y, c)) if kind == CONV_COLOR_TO_FLOAT
+                     else sum(c) / 3.0)
+                return Value(FLOAT, (f,))
         else:
-            weights = (weight_reg, weight_reg)
-        for shader_in, w in ((first, weights[0]), (second, weights[1])):
-            if isinstance(shader_in, Link):
-                _compile_shader(material, nodes, shader_in, w, program, path)
-        return
-    if node.type not in KIND:
-        raise SceneError(f"material '{material.name}': shader node {node.type} is not supported")
-    values = []
-    for name, size, default in INPUTS[node.type]:
-        if name.startswith("prop:"):
-            prop = node.props.get(name[5:])
-            values.append(float(DISTRIBUTIONS[prop]) if prop is not None else float(default))
-            continue
-        value = _constant(material, node, name, default)
-        values.extend(np.broadcast_to(np.asarray(value, float).ravel()[:size], (size,)).tolist())
-    base = program.reg(len(values)) if values else 0
-    if values:
-        _load(program, base, values)
-    program.ops.append([OP_CLOSURE, KIND[node.type], base, weight_reg])
+            kind = CONV_FLOAT_TO_VECTOR
+            if value.constant:
+                return Value(to, (value.const[0],) * 3)
+        out = self.program.reg(SIZE[to])
+        self.program.ops.append([OP_CONVERT, out, value.reg, kind])
+        return Value(to, reg=out)
 
 
-def _constant(material, node, name, default):
-    value = node.inputs.get(name, default)
-    if isinstance(value, Link):
-        raise SceneError(f"material '{material.name}': input '{name}' of {node.type} is linked; "
-                         f"only constant inputs are supported")
-    return value
-
-
-def _load(program: Program, reg: int, values) -> None:
-    program.ops.append([OP_CONST, reg, len(program.consts), len(values)])
-    program.consts.extend(float(v) for v in values)
+# What the compiler shows a node it evaluates ahead of time: no point, no scene.
+_HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
+                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0)
+_NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), tri_object=np.zeros(0, np.int32),
+                           objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS))
 
 
 class ShaderTable:
     """Every material's program in one pair of arrays, and what the renderer must know
     of each material before shading it.
 
-    ``ops`` (P, 4) int32 and ``consts`` (C,) float64 hold the programs;
-    ``ranges`` (M, 2) int32 is the [start, end) row range of material m's.
-    ``emission`` (M, 3) is the radiance the material emits as a light source,
-    evaluated as Cycles evaluates a light's shader (no closures built, so no
-    layer above the emission darkens it; facing the normal), and ``flags``
-    (M,) holds MF_* bits: emissive, transparent to shadow rays, bump-map correction.
+    ``ops`` (P, 4) int32 holds the programs, ``ranges`` (M, 2) int32 the
+    [start, end) row range of material m's, and ``registers`` (R,) float64 the
+    register file with every material's constants in place (each worker
+    copies it once per render).  ``emission`` (M, 3) is the radiance the
+    material emits as a light source, evaluated as Cycles evaluates a light's
+    shader (no closures built, so no layer above the emission darkens it;
+    facing the normal), and ``flags`` (M,) holds MF_* bits: emissive,
+    transparent to shadow rays, bump-map correction.
     """
 
-    def __init__(self, materials):
-        ops, consts, ranges = [], [], []
+    def __init__(self, materials, attributes: AttributeLayout | None = None):
+        ops, ranges, init = [], [], {}
+        programs = []
+        base = 0
         for m in materials:
-            program = compile_material(m)
-            start = len(ops)
-            for op, a, b, c in program.ops:
-                if op == OP_CONST:
-                    b += len(consts)
-                ops.append([op, a, b, c])
-            consts.extend(program.consts)
-            ranges.append([start, len(ops)])
+            program = compile_material(m, attributes, base)
+            base += program.registers
+            ranges.append([len(ops), len(ops) + len(program.ops)])
+            ops.extend(program.ops)
+            init.update(program.init)
+            programs.append(program)
         self.ops = np.array(ops, np.int32).reshape(-1, 4)
-        self.consts = np.array(consts, np.float64)
         self.ranges = np.array(ranges, np.int32).reshape(-1, 2)
+        self.registers = np.zeros(max(base, 1))
+        if init:
+            self.registers[np.fromiter(init.keys(), np.int64)] = np.fromiter(init.values(), float)
         self.emission = np.zeros((len(materials), 3))
         self.flags = np.zeros(len(materials), np.int32)
-        regs, cl = np.zeros(MAX_REGS), np.zeros((MAX_CLOSURES, CL_STRIDE))
-        for i, m in enumerate(materials):
-            sd = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
-                             False, True, True, m.use_bump_map_correction)
-            res = eval_shader(self.ops, self.consts, self.ranges[i, 0], self.ranges[i, 1], regs,
-                              cl, sd)
+        regs, cl = self.registers.copy(), np.zeros((MAX_CLOSURES, CL_STRIDE))
+        point = _HOST_POINT._replace(allocate=False, bump_correction=False)
+        for i, (m, program) in enumerate(zip(materials, programs)):
+            point = point._replace(bump_correction=m.use_bump_map_correction)
+            res = eval_shader(self.ops, self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
+                              _NO_TEXTURES)
             self.emission[i] = np.maximum((res.er, res.eg, res.eb), 0.0)
             flags = MF_BUMP_CORRECTION if m.use_bump_map_correction else 0
-            if self.emission[i].max() > 0.0:
+            if self.emission[i].max() > 0.0 or program.emission_varies:
                 flags |= MF_EMISSIVE
-            if m.use_transparent_shadow and max(res.tr, res.tg, res.tb) > 0.0:
+            if program.emission_varies:
+                flags |= MF_EMISSION_VARIES
+            if m.use_transparent_shadow and (max(res.tr, res.tg, res.tb) > 0.0
+                                             or program.transparency_varies):
                 flags |= MF_TRANSPARENT
             self.flags[i] = flags
+
+    def closure_kinds(self, m: int) -> list[int]:
+        """Closure node kinds in material m's program."""
+        start, end = self.ranges[m]
+        rows = self.ops[start:end]
+        return [int(k) for k in rows[rows[:, 0] == OP_CLOSURE, 1]]

@@ -1,14 +1,12 @@
 """Blender materials -> :class:`mcengine.scene.Material` (a graph of shader nodes).
 
-The graph read is what the Surface socket of the material's active Cycles
-output (``node_tree.get_output_node('CYCLES')``) receives, following
-reroutes, skipping muted links and passing through muted nodes as Blender
-does.  Every shader node the renderer evaluates is copied with all its inputs
-(their unlinked values) and its properties; the core shades them as Cycles
-does (``mcengine.kernels.svm``):
+The graph is what the Surface socket of the material's active Cycles output
+(``node_tree.get_output_node('CYCLES')``) receives, copied by
+:class:`shader_graph.GraphReader` (reroutes, muted links and nodes, node
+groups; every node the core evaluates, with its inputs and properties).  On
+top of that, materials translate a few shader nodes the core renders through
+others:
 
-* Principled, Diffuse, Glossy, Glass, Refraction, Translucent, Transparent,
-  Sheen, Emission and Holdout nodes, Mix Shader and Add Shader;
 * Metallic BSDF in F82 mode becomes the Principled BSDF at Metallic 1 (the
   same closure); in Physical Conductor mode its IOR and extinction are fitted
   to F82 (warned);
@@ -16,8 +14,6 @@ does (``mcengine.kernels.svm``):
   Principled's subsurface layer is rendered as diffuse (Cycles' own
   zero-radius limit), warned;
 * any other shader node: 0.8 grey diffuse (Cycles' default surface), warned;
-* a linked input that is not a shader (a texture, a math node, a normal map,
-  ...) is replaced by the socket's unlinked value, warned;
 * nothing linked to Surface, or no output: black, as in Cycles;
 * a material without a node tree uses ``diffuse_color``, as Cycles does.
 
@@ -28,8 +24,10 @@ from __future__ import annotations
 
 import math
 
-from mcengine.kernels.svm.nodes import INPUTS
+from mcengine.kernels.svm.nodes import Socket
 from mcengine.scene import Link, Material, ShaderNode
+
+from .shader_graph import GraphReader, label
 
 __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node", "clamp_color", "fmt"]
 
@@ -37,19 +35,6 @@ __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node"
 DEFAULT_GREY = (0.8, 0.8, 0.8)
 DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
 BLACK = (0.0, 0.0, 0.0)
-
-# Blender node types -> the graph's node types (the Glossy BSDF is
-# ShaderNodeBsdfAnisotropic since Blender 4.0).
-_NODE_TYPES = {
-    "ShaderNodeBsdfPrincipled": "BsdfPrincipled", "ShaderNodeBsdfDiffuse": "BsdfDiffuse",
-    "ShaderNodeBsdfAnisotropic": "BsdfGlossy", "ShaderNodeBsdfGlossy": "BsdfGlossy",
-    "ShaderNodeBsdfGlass": "BsdfGlass", "ShaderNodeBsdfRefraction": "BsdfRefraction",
-    "ShaderNodeBsdfTranslucent": "BsdfTranslucent", "ShaderNodeBsdfTransparent": "BsdfTransparent",
-    "ShaderNodeBsdfSheen": "BsdfSheen", "ShaderNodeEmission": "Emission",
-    "ShaderNodeHoldout": "Holdout", "ShaderNodeMixShader": "MixShader",
-    "ShaderNodeAddShader": "AddShader",
-}
-_ROUTING_INPUTS = {"MixShader": ("Fac", "Shader", "Shader_001"), "AddShader": ("Shader", "Shader_001")}
 _THIN_FILM_CUTOFF = 0.1
 
 
@@ -66,6 +51,11 @@ class MaterialTable:
         self._ctx = ctx
         self.materials = [DEFAULT_SURFACE]
         self._index = {None: 0}
+
+    def attribute_names(self) -> set:
+        """Names of the attributes the materials converted so far read (Attribute nodes)."""
+        return {str(node.props.get("attribute_name", "")) for m in self.materials
+                for node in m.nodes if node.type == "Attribute"}
 
     def index(self, material) -> int:
         """Index of a Blender material (None: the default surface), converting it once."""
@@ -88,11 +78,11 @@ def convert_material(ctx, material) -> Material:
     out = tree.get_output_node("CYCLES")
     if out is None:
         return Material(name=name, base_color=BLACK, **settings)
-    graph = _Graph()
+    graph = _MaterialGraph(ctx)
     for socket_name, what in (("Volume", "volume"), ("Displacement", "displacement")):
         src = linked_node(out.inputs[socket_name])
         if src is not None:
-            graph.note(f"{what} ({_label(src)})", what)
+            graph.note(f"{what} ({label(src)})", what)
     surface = graph.shader(out.inputs["Surface"])
     if surface is None:
         result = Material(name=name, base_color=BLACK, **settings)
@@ -104,140 +94,87 @@ def convert_material(ctx, material) -> Material:
     return result
 
 
-class _Graph:
-    """The shader graph being copied from one Blender material, and what it ignores."""
+class _MaterialGraph(GraphReader):
+    """A material's graph: the generic copy, plus the shader nodes rendered through others."""
 
-    def __init__(self):
-        self.nodes: list[ShaderNode] = []
-        self._index: dict = {}
-        self.items: list[str] = []
-        self.features: list[str] = []
-        self.fallbacks: list[str] = []
-
-    def note(self, item: str, feature: str, fallback: str = "") -> None:
-        if item not in self.items:
-            self.items.append(item)
-        if feature not in self.features:
-            self.features.append(feature)
-        if fallback and fallback not in self.fallbacks:
-            self.fallbacks.append(fallback)
-
-    def shader(self, socket) -> Link | None:
-        """The link a shader socket receives (None: nothing, black)."""
-        source = linked_socket(socket)
-        if source is None:
-            return None
-        node = source.node
-        key = node.as_pointer()
-        if key not in self._index:
-            self._index[key] = None     # a cycle through this node finds nothing
-            index = len(self.nodes)
-            self.nodes.append(ShaderNode(type="", name=node.name))
-            self.nodes[index] = self._convert(node)
-            self._index[key] = index
-        index = self._index[key]
-        if index is None:
-            self.note(f"{_label(node)} (a shader cycle)", "shader nodes")
-            return None
-        return Link(index, "Shader" if self.nodes[index].type in _ROUTING_INPUTS else "BSDF")
-
-    # -- one node -------------------------------------------------------------------------------
-    def _convert(self, node) -> ShaderNode:
+    def convert(self, node, groups) -> ShaderNode:
         kind = node.bl_idname
         if kind == "ShaderNodeBsdfMetallic":
-            return self._metallic(node)
+            return self._metallic(node, groups)
         if kind == "ShaderNodeSubsurfaceScattering":
-            self.note(f"{_label(node)} (subsurface scattering)", "subsurface",
-                      f"{_label(node)} rendered as diffuse of its colour")
-            return ShaderNode("BsdfDiffuse", {"Color": self._value(node, "Color", 3)}, name=node.name)
-        mapped = _NODE_TYPES.get(kind)
-        if mapped is None:
-            self.note(f"{_label(node)} surface shader", "shader nodes",
-                      f"{_label(node)} rendered as 0.8 grey diffuse")
-            return ShaderNode("BsdfDiffuse", {"Color": DEFAULT_GREY}, name=node.name)
-        if mapped in _ROUTING_INPUTS:
-            inputs = {}
-            for ident in _ROUTING_INPUTS[mapped]:
-                sock = node.inputs[ident]
-                if sock.type == "SHADER":
-                    link = self.shader(sock)
-                    if link is not None:
-                        inputs[ident] = link
-                else:
-                    inputs[ident] = self._value(node, ident, 1)
-            return ShaderNode(mapped, inputs, name=node.name)
-        inputs = {}
-        for ident, size, _default in INPUTS[mapped]:
-            if not ident.startswith("prop:"):
-                inputs[ident] = self._value(node, ident, size)
-        props = {}
-        if any(ident == "prop:distribution" for ident, _size, _default in INPUTS[mapped]):
-            props["distribution"] = self._distribution(node)
-        if mapped == "BsdfSheen" and node.distribution == "ASHIKHMIN":
-            self.note(f"{_label(node)} Ashikhmin velvet sheen", "velvet sheen",
+            self.note(f"{label(node)} (subsurface scattering)", "subsurface",
+                      f"{label(node)} rendered as diffuse of its colour")
+            return ShaderNode("BsdfDiffuse", {"Color": self._in(node, "Color", "color", groups)},
+                              name=node.name)
+        copied = super().convert(node, groups)
+        if copied.type == "BsdfSheen" and node.distribution == "ASHIKHMIN":
+            self.note(f"{label(node)} Ashikhmin velvet sheen", "velvet sheen",
                       "microfibre sheen used")
-        self._check(node, mapped, inputs)
-        return ShaderNode(mapped, inputs, props, name=node.name)
-
-    def _value(self, node, ident, size):
-        """The unlinked value of an input (a linked non-shader input is noted)."""
-        sock = node.inputs[ident]
-        src = linked_node(sock)
-        if src is not None:
-            self.note(f"{_label(src)} into {_label(node)} '{sock.name}'", "textures",
-                      f"unlinked value of {_label(node)} '{sock.name}' used")
-        value = sock.default_value
-        if size == 1:
-            return float(value)
-        values = [float(v) for v in value[:3]]
-        return tuple(values)
-
-    def _distribution(self, node) -> str:
-        dist = node.distribution
-        if dist == "ASHIKHMIN_SHIRLEY":
-            self.note(f"{_label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley",
+        if copied.props.get("distribution") == "ASHIKHMIN_SHIRLEY":
+            self.note(f"{label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley",
                       "GGX used")
-            return "GGX"
-        return dist
+            copied.props["distribution"] = "GGX"
+        self._check(node, copied.type, copied.inputs)
+        return copied
+
+    def _in(self, node, ident, kind, groups):
+        sockets = {s.identifier: s for s in node.inputs}
+        return self.input(node, sockets[ident], Socket(ident, kind, None), groups)
 
     def _check(self, node, kind, inputs) -> None:
         """Note what the closure model renders differently from Cycles."""
-        label = _label(node)
+        lbl = label(node)
         tangent = inputs.get("Tangent")
         aniso = inputs.get("Anisotropic", inputs.get("Anisotropy", 0.0))
-        if aniso and (tangent is None or not any(tangent)):
-            self.note(f"{label} anisotropy along the default (radial) tangent", "anisotropy",
-                      f"{label} rendered isotropic")
-        if inputs.get("Thin Film Thickness", 0.0) > _THIN_FILM_CUTOFF:
-            self.note(f"{label} thin film", "thin film", "thin-film interference ignored")
-        if kind == "BsdfPrincipled" and inputs["Subsurface Weight"] > 0.0:
-            self.note(f"{label} subsurface weight {fmt(inputs['Subsurface Weight'])}", "subsurface",
+        if aniso and (tangent is None or not isinstance(tangent, Link) and not any(tangent)):
+            self.note(f"{lbl} anisotropy along the default (radial) tangent", "anisotropy",
+                      f"{lbl} rendered isotropic")
+        thin = inputs.get("Thin Film Thickness", 0.0)
+        if isinstance(thin, Link) or thin > _THIN_FILM_CUTOFF:
+            self.note(f"{lbl} thin film", "thin film", "thin-film interference ignored")
+        sss = inputs.get("Subsurface Weight", 0.0)
+        if kind == "BsdfPrincipled" and (isinstance(sss, Link) or sss > 0.0):
+            self.note(f"{lbl} subsurface weight {fmt(sss) if not isinstance(sss, Link) else '(linked)'}",
+                      "subsurface",
                       "subsurface rendered as diffuse of the base colour (Cycles' zero-radius limit)")
 
-    def _metallic(self, node) -> ShaderNode:
+    def _metallic(self, node, groups) -> ShaderNode:
         """Metallic BSDF as the Principled at Metallic 1: the same F82-tint conductor."""
-        inputs = {"Metallic": 1.0, "Roughness": self._value(node, "Roughness", 1),
-                  "Anisotropic": min(max(self._value(node, "Anisotropy", 1), 0.0), 1.0),
-                  "Anisotropic Rotation": self._value(node, "Rotation", 1),
-                  "Normal": self._value(node, "Normal", 3), "Tangent": self._value(node, "Tangent", 3),
-                  "Thin Film Thickness": self._value(node, "Thin Film Thickness", 1)}
+        inputs = {"Metallic": 1.0}
+        for ident, to, kind in (("Roughness", "Roughness", "float"),
+                                ("Anisotropy", "Anisotropic", "float"),
+                                ("Rotation", "Anisotropic Rotation", "float"),
+                                ("Normal", "Normal", "vector"), ("Tangent", "Tangent", "vector"),
+                                ("Thin Film Thickness", "Thin Film Thickness", "float")):
+            value = self._in(node, ident, kind, groups)
+            if value is not None:
+                inputs[to] = value
+        if isinstance(inputs.get("Anisotropic"), float):
+            inputs["Anisotropic"] = min(max(inputs["Anisotropic"], 0.0), 1.0)
         if node.fresnel_type == "F82":
-            inputs["Base Color"] = self._value(node, "Base Color", 3)
-            inputs["Specular Tint"] = self._value(node, "Edge Tint", 3)
+            inputs["Base Color"] = self._in(node, "Base Color", "color", groups)
+            inputs["Specular Tint"] = self._in(node, "Edge Tint", "color", groups)
         else:
-            n = self._value(node, "IOR", 3)
-            k = self._value(node, "Extinction", 3)
+            n = _unlinked(node, "IOR")
+            k = _unlinked(node, "Extinction")
             f0 = [_conductor_fresnel(1.0, a, b) for a, b in zip(n, k)]
             f82 = [_conductor_fresnel(1.0 / 7.0, a, b) for a, b in zip(n, k)]
             schlick = [f + (1.0 - f) * (6.0 / 7.0) ** 5 for f in f0]
             inputs["Base Color"] = tuple(f0)
             inputs["Specular Tint"] = tuple(min(a / b, 1.0) if b > 0 else 1.0 for a, b in zip(f82, schlick))
-            self.note(f"{_label(node)} physical conductor Fresnel", "conductor fresnel",
+            self.note(f"{label(node)} physical conductor Fresnel", "conductor fresnel",
                       "fitted to the F82-tint model")
-        node_out = ShaderNode("BsdfPrincipled", inputs, {"distribution": self._distribution(node)},
-                              name=node.name)
-        self._check(node, "BsdfPrincipled", {**inputs, "Subsurface Weight": 0.0})
-        return node_out
+        props = {"distribution": node.distribution}
+        if props["distribution"] == "ASHIKHMIN_SHIRLEY":
+            self.note(f"{label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley", "GGX used")
+            props["distribution"] = "GGX"
+        self._check(node, "BsdfPrincipled", inputs)
+        return ShaderNode("BsdfPrincipled", inputs, props, name=node.name)
+
+
+def _unlinked(node, ident) -> tuple:
+    sockets = {s.identifier: s for s in node.inputs}
+    return tuple(float(v) for v in sockets[ident].default_value[:3])
 
 
 def _conductor_fresnel(cos_i, n, k) -> float:
@@ -283,10 +220,6 @@ def linked_node(socket):
     """The node feeding ``socket`` (see :func:`linked_socket`), or None."""
     source = linked_socket(socket)
     return source.node if source is not None else None
-
-
-def _label(node) -> str:
-    return node.label or node.name
 
 
 def clamp_color(values) -> tuple:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from mcengine.scene import Geometry
+from mcengine.scene import Geometry, auto_texspace_size
 
 __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances"]
 
@@ -56,6 +56,9 @@ class LocalMesh:
     normals         (T, 3, 3) float32  shading normal per corner
     uvs             (T, 3, 2) float32  UV per corner (zeros without a UV map)
     material_index  (T,) int32      index into the scene's material table
+    attributes      name -> (T, 3, C) float32  every UV map and colour attribute by name,
+                    and the other attributes the materials read
+    texspace        (2, 3) float64  generated texture space: centre and half-size
     """
 
     vertices: np.ndarray
@@ -63,6 +66,8 @@ class LocalMesh:
     normals: np.ndarray
     uvs: np.ndarray
     material_index: np.ndarray
+    attributes: dict
+    texspace: np.ndarray
 
 
 class MeshCollector:
@@ -81,6 +86,7 @@ class MeshCollector:
         self._meshes: dict[tuple, LocalMesh | None] = {}
         self._matrices: dict[tuple, list] = {}
         self._names: dict[tuple, list] = {}
+        self._infos: dict[tuple, list] = {}
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
         self._noted: dict[str, list] = {}
 
@@ -106,11 +112,13 @@ class MeshCollector:
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
-            self._meshes[key] = read_local_mesh(ob, slots)
-            self._matrices[key], self._names[key] = [], []
+            self._meshes[key] = read_local_mesh(ob, slots, self._materials.attribute_names())
+            self._matrices[key], self._names[key], self._infos[key] = [], [], []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
+            self._infos[key].append([float(inst.random_id & 0xFFFFFFFF), float(ob.pass_index),
+                                     *(float(c) for c in ob.color)])
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -123,7 +131,8 @@ class MeshCollector:
         for key, mesh in self._meshes.items():
             if mesh is not None:
                 parts.append(transform_instances(mesh, np.stack(self._matrices[key]),
-                                                 self._ctx.unit_scale, self._names[key]))
+                                                 self._ctx.unit_scale, self._names[key],
+                                                 np.array(self._infos[key], np.float64)))
         return Geometry.concatenate(parts)
 
     def _note(self, feature: str, object_name: str) -> None:
@@ -132,7 +141,7 @@ class MeshCollector:
             names.append(object_name)
 
 
-def read_local_mesh(ob, slot_materials) -> LocalMesh | None:
+def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
     """Read an evaluated object's mesh in object space (None if it has no triangles).
 
     Parameters
@@ -141,6 +150,9 @@ def read_local_mesh(ob, slot_materials) -> LocalMesh | None:
         Evaluated object whose data is a Mesh.
     slot_materials : tuple of int
         Scene material index of each material slot (empty: default surface).
+    wanted : collection of str
+        Names of generic attributes some material reads (UV maps and colour
+        attributes are always read).
     """
     me = ob.to_mesh()
     try:
@@ -161,6 +173,8 @@ def read_local_mesh(ob, slot_materials) -> LocalMesh | None:
         else:
             uvs = _get(uv_layer.uv, "vector", np.float32, len(me.loops) * 2).reshape(-1, 2)[loops]
         slot = _polygon_material_index(me)[polygons]
+        attributes = _corner_attributes(me, loops, triangles.reshape(-1), polygons, wanted)
+        texspace = _texspace(ob)
     finally:
         ob.to_mesh_clear()
     if slot_materials:
@@ -170,10 +184,11 @@ def read_local_mesh(ob, slot_materials) -> LocalMesh | None:
         mat = np.zeros(t, np.int32)
     return LocalMesh(vertices=vertices.astype(np.float64), triangles=triangles,
                      normals=normals.reshape(t, 3, 3), uvs=uvs.reshape(t, 3, 2),
-                     material_index=mat)
+                     material_index=mat, attributes=attributes, texspace=texspace)
 
 
-def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names) -> Geometry:
+def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names,
+                        infos=None) -> Geometry:
     """Place N instances of a local mesh in world space.
 
     Parameters
@@ -186,6 +201,8 @@ def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names) -> 
         Metres per Blender unit.
     names : list of str
         N object names (for messages).
+    infos : (N, 6) float, optional
+        Object Info per instance: random id, pass index, colour RGBA (zeros if None).
 
     Returns
     -------
@@ -211,6 +228,13 @@ def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names) -> 
     tris[flip] = tris[flip][:, :, _FLIP]
     normals[flip] = normals[flip][:, :, _FLIP]
     uvs[flip] = uvs[flip][:, :, _FLIP]
+    attributes = {}
+    for attr_name, values in mesh.attributes.items():
+        tiled = np.broadcast_to(values, (n, *values.shape)).copy()
+        tiled[flip] = tiled[flip][:, :, _FLIP]
+        attributes[attr_name] = tiled.reshape(-1, 3, values.shape[2])
+    object_matrix = m.copy()
+    object_matrix[:, :3, :] *= unit_scale
     pos = pos.reshape(-1, 3)
     tris = tris.reshape(-1, 3)
     normals = _unit_normals(normals.reshape(-1, 3, 3), pos, tris)
@@ -221,7 +245,10 @@ def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names) -> 
         uvs=uvs.reshape(-1, 3, 2).astype(np.float32),
         material_index=np.tile(mesh.material_index, n).astype(np.int32),
         object_index=np.repeat(np.arange(n, dtype=np.int32), t),
-        object_names=list(names),
+        object_names=list(names), attributes=attributes,
+        object_matrix=object_matrix,
+        object_texspace=np.broadcast_to(mesh.texspace, (n, 2, 3)).copy(),
+        object_info=np.zeros((n, 6)) if infos is None else np.asarray(infos, np.float64).reshape(n, 6),
     )
 
 
@@ -287,3 +314,47 @@ def _render_uv_layer(me):
         if layer.active_render:
             return layer
     return me.uv_layers.active
+
+
+# Attribute data types the shader nodes can read, and their component counts.
+_ATTRIBUTE_TYPES = {"FLOAT": 1, "INT": 1, "BOOLEAN": 1, "INT8": 1, "FLOAT2": 2, "INT32_2D": 2,
+                    "FLOAT_VECTOR": 3, "FLOAT_COLOR": 4, "BYTE_COLOR": 4, "QUATERNION": 4}
+_VALUE_FIELD = {1: "value", 2: "vector", 3: "vector", 4: "color"}
+
+
+def _corner_attributes(me, loops, corner_vertices, polygons, wanted) -> dict:
+    """Every UV map and colour attribute, and the wanted generic attributes, per triangle
+    corner: name -> (T, 3, C) float32.  Byte colours come out linear (Blender decodes
+    them per corner, as Cycles does before interpolating)."""
+    t = len(polygons)
+    out = {}
+    for layer in me.uv_layers:
+        uv = _get(layer.uv, "vector", np.float32, len(me.loops) * 2).reshape(-1, 2)
+        out[layer.name] = uv[loops].reshape(t, 3, 2)
+    colors = {a.name for a in me.color_attributes}
+    for attr in me.attributes:
+        name = attr.name
+        if name in out or name.startswith(".") or (name not in colors and name not in wanted):
+            continue
+        size = _ATTRIBUTE_TYPES.get(attr.data_type)
+        domain = {"POINT": corner_vertices, "CORNER": loops, "FACE": np.repeat(polygons, 3)}.get(attr.domain)
+        if size is None or domain is None:
+            continue
+        count = len(attr.data)
+        if attr.data_type in ("FLOAT_COLOR", "BYTE_COLOR"):
+            field_name = "color"
+        elif attr.data_type == "QUATERNION":
+            field_name = "value"
+        else:
+            field_name = _VALUE_FIELD[size]
+        values = _get(attr.data, field_name, np.float32, count * size).reshape(count, size)
+        out[name] = values[domain].reshape(t, 3, size)
+    return out
+
+
+def _texspace(ob) -> np.ndarray:
+    """The mesh's texture space (centre, half-size) in object space, as Cycles reads it."""
+    data = ob.data
+    loc = np.array(getattr(data, "texspace_location", (0.0, 0.0, 0.0)), np.float64)
+    size = np.array(getattr(data, "texspace_size", (1.0, 1.0, 1.0)), np.float64)
+    return auto_texspace_size(np.stack([loc, size]))

@@ -195,7 +195,9 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
             continue   # a terminated path only collects emission, and there is none
-        res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
+                          (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i],
+                           st.transparent[i]))
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,
                                flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,
@@ -223,7 +225,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                     pmf = sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
                 n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
-                                        cl, ncl, sp, dx, dy, dz, idx, pmf, bounce,
+                                        scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce,
                                         rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V),
                                         nee_mis, float(branching),
                                         cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])

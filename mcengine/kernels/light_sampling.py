@@ -60,12 +60,13 @@ LightSample = namedtuple("LightSample", [
     "cast_shadow",         # a shadow ray decides visibility
     "exclude",             # BSDF lobe labels the light must not illuminate
     "lnx", "lny", "lnz",   # emitter's unit normal (zero for lamps), to offset the shadow ray's end
+    "tri", "b1", "b2",     # the emissive triangle and the point's barycentrics (lamps: -1)
 ])
 
 
 @device
 def _no_light():
-    return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0)
+    return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0, -1, 0.0, 0.0)
 
 
 def light_distribution(lamp_power, tri_power):
@@ -102,13 +103,13 @@ def group_importance(group, px, py, pz):
 
 @device
 def sample_triangle_point(verts, tris, tri, u1, u2):
-    """Uniform point on triangle ``tri``."""
+    """Uniform point on triangle ``tri``: (x, y, z, b1, b2)."""
     b1, b2 = uniform_triangle(u1, u2)
     b0 = 1.0 - b1 - b2
     a, b, c = tris[tri, 0], tris[tri, 1], tris[tri, 2]
     return (b0 * verts[a, 0] + b1 * verts[b, 0] + b2 * verts[c, 0],
             b0 * verts[a, 1] + b1 * verts[b, 1] + b2 * verts[c, 1],
-            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2])
+            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2], b1, b2)
 
 
 
@@ -297,9 +298,10 @@ def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, 
             use_mis = False
             lr, lg, lb = lr / pmf, lg / pmf, lb / pmf
         return LightSample(wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis,
-                           (lflags & LF_CAST_SHADOW) != 0, nee_exclude(lflags), 0.0, 0.0, 0.0)
-    tri = emit_tri[idx - n_lamps]
-    qx, qy, qz = sample_triangle_point(verts, tris, tri, u1, u2)
+                           (lflags & LF_CAST_SHADOW) != 0, nee_exclude(lflags), 0.0, 0.0, 0.0,
+                           -1, 0.0, 0.0)
+    tri = np.int64(emit_tri[idx - n_lamps])
+    qx, qy, qz, b1, b2 = sample_triangle_point(verts, tris, tri, u1, u2)
     lx, ly, lz = qx - hx, qy - hy, qz - hz
     d2 = lx * lx + ly * ly + lz * lz
     dist = math.sqrt(d2)
@@ -314,4 +316,4 @@ def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, 
     em = mat_index[tri]
     return LightSample(wix, wiy, wiz, dist, mat_emission[em, 0] / pdf_l,
                        mat_emission[em, 1] / pdf_l, mat_emission[em, 2] / pdf_l,
-                       pdf_l, True, True, 0, lnx, lny, lnz)
+                       pdf_l, True, True, 0, lnx, lny, lnz, tri, b1, b2)

@@ -145,7 +145,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
             continue   # a terminated path only collects emission, and there is none
-        res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, not terminate)
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
+                          (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i],
+                           st.transparent[i]))
 
         # Holdout: the film's alpha drops by the holdout weight on camera paths.
         if res.holdout > 0.0 and (flags & PF_TRANSPARENT_BG):
@@ -193,7 +195,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
             n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
-                                    scratch.cl, ncl, sp, dx, dy, dz, idx, pmf, bounce,
+                                    scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce,
                                     rand(key, bounce_dim(vertex, DIM_LIGHT_U)),
                                     rand(key, bounce_dim(vertex, DIM_LIGHT_V)), True, 1.0,
                                     max_transparent - st.transparent[i])

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
-from ..jit import device
+from ..jit import device, kernel
 from .closures import (
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
@@ -62,17 +62,20 @@ from .state import (
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
     MF_BUMP_CORRECTION,
+    MF_EMISSION_VARIES,
     PF_CAMERA,
     PF_DIFFUSE,
     PF_GLOSSY,
     PF_MIS_SKIP,
     PF_REFLECT,
+    PF_SHADOW,
     PF_TERMINATE,
     PF_TRANSMIT,
     PF_TRANSPARENT,
     PF_TRANSPARENT_BG,
     ST_NONFINITE,
 )
+from .surface import surface_point
 from .svm import ShadingData, eval_shader
 
 DirectionSample = namedtuple("DirectionSample", [
@@ -225,8 +228,10 @@ def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
 
 
 @device
-def shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, allocate):
-    """Run material m's shader at ``sp`` for a ray of direction d and path ``flags``.
+def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths):
+    """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
+    direction d and length t_hit, on a path with ``flags`` and ``depths`` (bounces: all,
+    diffuse, glossy, transmission, transparent).
 
     The closures go to ``scratch.cl``; returns the ``ShaderResult``.  With
     ``allocate`` false only emission, transparency and holdout are computed.
@@ -236,9 +241,46 @@ def shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, flags, allocate):
                      -dx, -dy, -dz, sp.backfacing, allocate,
                      cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
                      cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
-                     (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0)
-    return eval_shader(sc.svm_ops, sc.svm_consts, sc.mat_prog[m, 0], sc.mat_prog[m, 1],
-                       scratch.regs, scratch.cl, sd)
+                     (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
+                     p, b1, b2, sc.tex.tri_object[p], flags, t_hit,
+                     depths[0], depths[1], depths[2], depths[3], depths[4])
+    return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
+                       sd, sc.tex)
+
+
+@device
+def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist):
+    """Radiance emitted by triangle ``tri`` at barycentrics (b1, b2) towards a ray of
+    direction d and length dist that reaches it there (a light sample of a material whose
+    emission varies over the surface: its shader runs there, without closures)."""
+    m = sc.mat_index[tri]
+    sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, tri, b1, b2, dx, dy, dz)
+    sd = ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
+                     -dx, -dy, -dz, sp.backfacing, False, True, True, False,
+                     tri, b1, b2, sc.tex.tri_object[tri], PF_SHADOW, dist, 0, 0, 0, 0, 0)
+    res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
+                      scratch.cl_light, sd, sc.tex)
+    return res.er, res.eg, res.eb
+
+
+@kernel
+def emission_estimates(sc, scratch, tris, out):
+    """Mean emitted radiance of each triangle in ``tris`` over four points (its centroid and
+    the midpoints towards its corners), facing its normal: the light-picking weights of
+    materials whose emission varies over the surface."""
+    points = ((1.0 / 3.0, 1.0 / 3.0), (1.0 / 6.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 6.0),
+              (1.0 / 6.0, 2.0 / 3.0))
+    for j in range(tris.shape[0]):
+        t = tris[j]
+        r = g = b = 0.0
+        for k in range(4):
+            b1, b2 = points[k]
+            er, eg, eb = emission_at(sc, scratch, t, b1, b2, -sc.tri_normal[t, 0],
+                                     -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0)
+            r += er
+            g += eg
+            b += eb
+        out[j, 0], out[j, 1], out[j, 2] = 0.25 * r, 0.25 * g, 0.25 * b
 
 
 @device
@@ -254,10 +296,10 @@ def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, cos_o, flag
 
 # -- 5. next-event estimation -----------------------------------------------------------------
 @device
-def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, cl, ncl, sp, dx, dy, dz, idx,
+def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl, sp, dx, dy, dz, idx,
                  pmf, bounce, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
     """Light from light ``idx`` (picked with probability ``pmf``) scattered at ``sp`` by
-    the ``ncl`` closures in ``cl`` towards the viewer (-d).
+    the ``ncl`` closures in ``scratch.cl`` towards the viewer (-d).
 
     The light is added to ``out[row]`` at once if the light casts no shadow,
     else queued behind a shadow ray owned by ``row``; returns the queue length.
@@ -268,13 +310,18 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, cl, ncl, sp, 
         return n_shadow
     ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
                       sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
-    if ls.lr == 0.0 and ls.lg == 0.0 and ls.lb == 0.0:   # (lights may be negative)
+    lr, lg, lb = ls.lr, ls.lg, ls.lb
+    if ls.tri >= 0 and (sc.mat_flags[sc.mat_index[ls.tri]] & MF_EMISSION_VARIES):
+        er, eg, eb = emission_at(sc, scratch, ls.tri, ls.b1, ls.b2, ls.wix, ls.wiy, ls.wiz, ls.dist)
+        lr, lg, lb = er / ls.pdf, eg / ls.pdf, eb / ls.pdf
+    if lr == 0.0 and lg == 0.0 and lb == 0.0:   # (lights may be negative)
         return n_shadow
-    fr_, fg_, fb_, bsdf_pdf = bsdf_eval(cl, ncl, -dx, -dy, -dz, ls.wix, ls.wiy, ls.wiz, ls.exclude)
+    fr_, fg_, fb_, bsdf_pdf = bsdf_eval(scratch.cl, ncl, -dx, -dy, -dz, ls.wix, ls.wiy, ls.wiz,
+                                        ls.exclude)
     w = power_heuristic(ls.pdf, bsdf_pdf_scale * bsdf_pdf) if (mis_on and ls.use_mis) else 1.0
-    cr = beta[i, 0] * fr_ * ls.lr * w
-    cg = beta[i, 1] * fg_ * ls.lg * w
-    cb = beta[i, 2] * fb_ * ls.lb * w
+    cr = beta[i, 0] * fr_ * lr * w
+    cg = beta[i, 1] * fg_ * lg * w
+    cb = beta[i, 2] * fb_ * lb * w
     if cr == 0.0 and cg == 0.0 and cb == 0.0:
         return n_shadow
     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]

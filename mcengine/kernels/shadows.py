@@ -17,7 +17,7 @@ import numpy as np
 from ..jit import kernel
 from .intersect import SHADOW_SHORTEN, intersect_prim, offset_scale
 from .shading import shade_point
-from .state import CFG_MAX_TRANSPARENT, CFG_TRANSPARENT_SHADOWS, MF_TRANSPARENT, ST_SHADOW_RAYS
+from .state import CFG_MAX_TRANSPARENT, CFG_TRANSPARENT_SHADOWS, MF_TRANSPARENT, PF_SHADOW, ST_SHADOW_RAYS
 from .surface import surface_point
 
 # sq.alive values while tracing transparent shadows.
@@ -72,7 +72,8 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         if not math.isfinite(t):
             t = 0.0
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
-        res = shade_point(sc, cfg, scratch, sp, m, dx, dy, dz, 0, False)
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t, PF_SHADOW, False,
+                          (0, 0, 0, 0, 0))
         sq.contrib[s, 0] *= res.tr
         sq.contrib[s, 1] *= res.tg
         sq.contrib[s, 2] *= res.tb

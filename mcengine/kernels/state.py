@@ -13,7 +13,6 @@ from collections import namedtuple
 import numpy as np
 
 from .closures.layout import CL_STRIDE, MAX_CLOSURES
-from .svm import MAX_REGS
 
 # -- path state ----------------------------------------------------------------------
 PathState = namedtuple("PathState", [
@@ -53,7 +52,8 @@ ShadowQueue = namedtuple("ShadowQueue", [
 
 Scratch = namedtuple("Scratch", [
     "cl",                  # (MAX_CLOSURES, CL_STRIDE) f64  the closures of the point being shaded
-    "regs",                # (MAX_REGS,) f64                the shader evaluator's registers
+    "cl_light",            # the same, for evaluating the emission of a light sample
+    "regs",                # (R,) f64  the shader evaluator's registers (a copy of SceneData.svm_regs)
 ])
 
 SceneData = namedtuple("SceneData", [
@@ -62,7 +62,8 @@ SceneData = namedtuple("SceneData", [
     "normals",       # (T, 3, 3) f32  shading normals at the corners
     "mat_index",     # (T,) int32
     "svm_ops",       # (P, 4) int32  every material's shader program (kernels.svm)
-    "svm_consts",    # (C,) f64      their constants
+    "svm_regs",      # (R,) f64      their registers with the constants in place (each worker
+                     #               shades with its own copy, Scratch.regs)
     "mat_prog",      # (M, 2) int32  [start, end) of material m's program in svm_ops
     "mat_emission",  # (M, 3) f64    emitted radiance of material m as a light (no layering)
     "mat_flags",     # (M,) int32    MF_* bits
@@ -78,12 +79,14 @@ SceneData = namedtuple("SceneData", [
     "world",         # (3,) f64     background radiance
     "camera",        # (CAMERA_PARAMS,) f64
     "filter_table",  # (FILTER_TABLE_SIZE,) f64
+    "tex",           # svm.TextureData: attributes, objects, images for the shader nodes
 ])
 
 # Material flags (mat_flags).
 MF_EMISSIVE = 1           # emits light: its triangles are lights for next-event estimation
 MF_TRANSPARENT = 2        # has transparent closures and lets shadow rays through them
 MF_BUMP_CORRECTION = 4    # Cycles' use_bump_map_correction
+MF_EMISSION_VARIES = 8    # its emission depends on the point (textures): light samples run its shader
 
 # Path flags.
 PF_CAMERA = 1            # no scattering yet: the ray is a camera ray
@@ -95,6 +98,7 @@ PF_GLOSSY = 32
 PF_TRANSMIT = 64
 PF_REFLECT = 128
 PF_TRANSPARENT = 256      # the path passed a transparent closure (Cycles' PATH_RAY_TRANSPARENT)
+PF_SHADOW = 512           # shading for a shadow ray (transparent shadows; Light Path's Is Shadow Ray)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -156,7 +160,8 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
                        transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8))
 
 
-def alloc_scratch() -> Scratch:
-    """A worker's per-hit scratch space (closures and shader registers)."""
-    return Scratch(cl=np.zeros((MAX_CLOSURES, CL_STRIDE)), regs=np.zeros(MAX_REGS))
+def alloc_scratch(sc: SceneData) -> Scratch:
+    """A worker's per-hit scratch space for scene ``sc`` (closures and shader registers)."""
+    return Scratch(cl=np.zeros((MAX_CLOSURES, CL_STRIDE)), cl_light=np.zeros((MAX_CLOSURES, CL_STRIDE)),
+                   regs=sc.svm_regs.copy())
 

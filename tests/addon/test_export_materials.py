@@ -45,9 +45,9 @@ def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
     mat.node_tree.nodes["Principled BSDF"].distribution = "GGX"
     m, warnings = exported(fake_session, mat)
     node = surface(m)
-    assert node.type == "BsdfPrincipled" and node.props == {"distribution": "GGX"}
-    assert set(node.inputs) == {name for name, _s, _d in INPUTS["BsdfPrincipled"]
-                                if not name.startswith("prop:")}
+    assert node.type == "BsdfPrincipled" and node.props["distribution"] == "GGX"
+    assert set(node.inputs) == {socket.name for socket in INPUTS["BsdfPrincipled"]
+                                if not socket.name.startswith("prop:")}
     assert node.inputs["Base Color"] == pytest.approx((0.2, 0.4, 0.6))
     assert (node.inputs["Roughness"], node.inputs["Metallic"], node.inputs["Coat Weight"]) == \
         pytest.approx((0.3, 0.25, 0.5))
@@ -56,16 +56,59 @@ def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
     assert warnings == []
 
 
-def test_texture_into_base_color_gives_exactly_one_warning(scene, fake_session):
+def test_unsupported_texture_into_base_color_gives_exactly_one_warning(scene, fake_session):
     mat = principled("Wood", Base_Color=(0.5, 0.25, 0.1, 1))
-    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
-    mat.node_tree.links.new(noise.outputs["Color"],
+    wire = mat.node_tree.nodes.new("ShaderNodeWireframe")
+    mat.node_tree.links.new(wire.outputs["Fac"],
                             mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
     m, warnings = exported(fake_session, mat)
     assert surface(m).inputs["Base Color"] == pytest.approx((0.5, 0.25, 0.1))
-    assert warnings == ["material 'Wood': Noise Texture into Principled BSDF 'Base Color' not "
+    assert warnings == ["material 'Wood': Wireframe into Principled BSDF 'Base Color' not "
                         "supported yet; unlinked value of Principled BSDF 'Base Color' used"]
-    assert "textures" in scene.mcengine.last_ignored
+    assert "Wireframe node" in scene.mcengine.last_ignored
+
+
+def test_linked_texture_is_copied_with_its_properties(scene, fake_session):
+    mat = principled("Tiles")
+    tree = mat.node_tree
+    checker = tree.nodes.new("ShaderNodeTexChecker")
+    checker.inputs["Scale"].default_value = 7.0
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    reroute = tree.nodes.new("NodeReroute")
+    tree.links.new(coords.outputs["UV"], reroute.inputs[0])
+    tree.links.new(reroute.outputs[0], checker.inputs["Vector"])
+    tree.links.new(checker.outputs["Fac"], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    m, warnings = exported(fake_session, mat)
+    link = surface(m).inputs["Roughness"]
+    assert isinstance(link, Link) and link.socket == "Fac"
+    tex = m.nodes[link.node]
+    assert tex.type == "TexChecker" and tex.inputs["Scale"] == 7.0
+    vector = tex.inputs["Vector"]
+    assert isinstance(vector, Link) and vector.socket == "UV" and m.nodes[vector.node].type == "TexCoord"
+    assert warnings == []
+
+
+def test_node_groups_are_flattened(scene, fake_session):
+    group = bpy.data.node_groups.new("Tint", "ShaderNodeTree")
+    group.interface.new_socket("In", in_out="INPUT", socket_type="NodeSocketColor")
+    group.interface.new_socket("Out", in_out="OUTPUT", socket_type="NodeSocketColor")
+    g_in = group.nodes.new("NodeGroupInput")
+    g_out = group.nodes.new("NodeGroupOutput")
+    inner = group.nodes.new("ShaderNodeTexChecker")
+    group.links.new(g_in.outputs[0], inner.inputs["Color1"])
+    group.links.new(inner.outputs["Color"], g_out.inputs[0])
+    mat = principled("Grouped")
+    tree = mat.node_tree
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    node.inputs[0].default_value = (0.1, 0.2, 0.3, 1.0)
+    tree.links.new(node.outputs[0], tree.nodes["Principled BSDF"].inputs["Base Color"])
+    m, warnings = exported(fake_session, mat)
+    link = surface(m).inputs["Base Color"]
+    tex = m.nodes[link.node]
+    assert tex.type == "TexChecker" and link.socket == "Color"
+    assert tex.inputs["Color1"] == pytest.approx((0.1, 0.2, 0.3))
+    assert warnings == []
 
 
 def test_diffuse_bsdf_with_roughness(scene, fake_session):
@@ -116,7 +159,7 @@ def test_every_bsdf_node_is_copied(scene, fake_session, bl_idname, kind):
     if "IOR" in out.inputs:
         assert out.inputs["IOR"] == pytest.approx(1.33)
     if hasattr(node, "distribution") and kind != "BsdfSheen":
-        assert out.props == {"distribution": node.distribution}
+        assert out.props["distribution"] == node.distribution
     assert warnings == []
 
 

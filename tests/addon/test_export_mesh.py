@@ -141,9 +141,9 @@ def count_mesh_reads(addon, monkeypatch):
     calls = []
     real = addon.export.mesh.read_local_mesh
 
-    def counting(ob, slots):
+    def counting(ob, slots, wanted=()):
         calls.append(ob.name)
-        return real(ob, slots)
+        return real(ob, slots, wanted)
 
     monkeypatch.setattr(addon.export.mesh, "read_local_mesh", counting)
     return calls
@@ -252,10 +252,10 @@ def test_one_failing_object_is_skipped_with_a_warning(scene, fake_session, addon
     new_mesh_object("Bad", TRI, [(0, 1, 2)]).location = (5, 0, 0)
     real = addon.export.mesh.read_local_mesh
 
-    def failing(ob, slots):
+    def failing(ob, slots, wanted=()):
         if ob.name == "Bad":
             raise ValueError("broken mesh")
-        return real(ob, slots)
+        return real(ob, slots, wanted)
 
     monkeypatch.setattr(addon.export.mesh, "read_local_mesh", failing)
     desc = export_scene(fake_session)

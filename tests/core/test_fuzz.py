@@ -213,8 +213,9 @@ def _brightness_bound(scene) -> float:
         if li.type == "SUN":
             half = li.angle / 2
             irradiance += p
-            if half > 0:
-                seen = max(seen, p / (math.pi * math.sin(half) ** 2))
+            if half > 0:    # a sun small enough for sin^2 to underflow: no finite bound
+                solid = math.pi * math.sin(half) ** 2
+                seen = max(seen, p / solid if solid > 0 else math.inf)
         elif li.type == "AREA":
             sx, sy = li.size_x, li.size_x if li.shape in ("SQUARE", "DISK") else li.size_y
             scale = np.linalg.norm(np.asarray(li.matrix_world)[:3, :2], axis=0)

@@ -17,6 +17,7 @@ import pytest
 
 from mcengine import memory
 from mcengine.film import Film
+from mcengine.kernels.state import alloc_scratch
 from mcengine.scene import Light, SceneDescription, SceneError
 from mcengine.session import RenderSession, _Buffers
 
@@ -149,8 +150,10 @@ def test_memory_estimate_counts_what_a_render_allocates():
     session = RenderSession(scene, threads=2).run()
     film_arrays = sum(a.nbytes for a in session.film.arrays)
     assert memory.estimate(640 * 480, 0, 0).film == film_arrays + session.active.nbytes
-    # bytes_for (used before allocating) equals what the two workers allocated.
-    assert session.buffer_bytes - film_arrays == 2 * _Buffers.bytes_for(session.batch_size, False)
+    # bytes_for (used before allocating) equals what the two workers allocated for their
+    # paths; each worker also holds a scratch copy of the scene's closures and registers.
+    scratch = sum(a.nbytes for a in alloc_scratch(session.sc))
+    assert session.buffer_bytes - film_arrays == 2 * (_Buffers.bytes_for(session.batch_size, False) + scratch)
 
 
 def test_film_read_out_is_exact_and_flips_without_copies():

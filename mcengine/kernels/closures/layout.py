@@ -45,7 +45,8 @@ CL_P1 = 31               # sheen LTC a, b)
 CL_P2 = 32
 CL_P3 = 33
 CL_P4 = 34
-CL_STRIDE = 36
+CL_ALBEDO = 36           # 3: microfacet: the albedo estimate at the view, from the setup (layering)
+CL_STRIDE = 39
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0

@@ -47,6 +47,7 @@ from .fresnel import (
     fresnel_f82_Fss,
 )
 from .layout import (
+    CL_ALBEDO,
     CL_AX,
     CL_AY,
     CL_DIST,
@@ -669,9 +670,11 @@ microfacet_estimate_albedo = microfacet_albedo     # Cycles' name
 
 @device
 def microfacet_setup_sample_weight(cl, k, cos_no):
-    """CL_SW *= the mean albedo estimate R + T at the view (what every Cycles Fresnel setup does first)."""
+    """CL_SW *= the mean albedo estimate R + T at the view (what every Cycles Fresnel setup does
+    first); the estimate is kept in CL_ALBEDO for the layering of the closures below."""
     r, g, b = microfacet_albedo(cl, k, cos_no, True, True)
     cl[k, CL_SW] *= (r + g + b) * (1.0 / 3.0)
+    cl[k, CL_ALBEDO], cl[k, CL_ALBEDO + 1], cl[k, CL_ALBEDO + 2] = r, g, b
 
 
 @device

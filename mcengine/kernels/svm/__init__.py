@@ -1,13 +1,19 @@
 """The shader evaluator: runs a material's program at a shading point.
 
 ``mcengine.shaders`` compiles each material's node graph into rows of four
-int32 ``[op, a, b, c]`` plus a pool of float64 constants, in the manner of
-Cycles' SVM (kernel/svm/).  ``eval_shader`` runs a material's rows with a
-register file ``regs`` (float64, owned by the worker) and writes the
-material's closures at this point into the closure list ``cl`` (see
+int32 ``[op, a, b, c]``, in the manner of Cycles' SVM (kernel/svm/).  Every
+material owns a range of the register file ``regs`` (float64, one copy per
+worker): its constants are written there once per render
+(``ShaderTable.registers``), so a material whose inputs are all constant
+runs nothing but its closure rows.  ``eval_shader`` runs a material's rows
+and writes its closures at this point into the closure list ``cl`` (see
 ``closures.layout``).  Operations:
 
-``OP_CONST``       a = first register, b = first constant, c = count: copy constants
+``OP_NODE``        a = node code (``nodes.VALUE_NODES``), b = its first input register,
+                   c = its first output register: evaluate a value node
+``OP_COPY``        a = destination register, b = source register, c = count
+``OP_CONVERT``     a = destination, b = source, c = ``CONV_*``: a link between sockets of
+                   different types (Cycles' implicit conversions)
 ``OP_MIX_WEIGHT``  a = factor register, b = incoming weight register (-1: 1),
                    c = first of two registers: in x (1 - fac), in x fac
 ``OP_CLOSURE``     a = node kind (``nodes.K_*``), b = its first input register,
@@ -15,33 +21,47 @@ material's closures at this point into the closure list ``cl`` (see
 
 The result is the number of closures, the emitted radiance, the transparency
 (the summed weight of transparent closures, which shadow rays pass through)
-and the holdout weight.  ``ShadingData`` is what the nodes see of the point.
+and the holdout weight.  ``ShadingData`` is what the nodes see of the point,
+``TextureData`` what they read of the scene (attributes, objects, images).
 """
 from __future__ import annotations
 
 from collections import namedtuple
 
-from ...jit import function
+from ...jit import device, function
 from .closure_nodes import eval_closure_node
+from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
+    ATTR_DEFAULT_UV,
+    OBJ_COLOR,
+    OBJ_INVERSE,
+    OBJ_MATRIX,
+    OBJ_PASS_INDEX,
+    OBJ_RANDOM,
+    OBJ_STRIDE,
+    OBJ_TEXSPACE_LOC,
+    OBJ_TEXSPACE_SIZE,
+    ShadingData,
+    TextureData,
+)
+from .input_nodes import eval_input_node
+from .nodes import FAMILY_INPUT, FAMILY_TEXTURE
+from .texture_nodes import eval_texture_node
 
 OP_END = 0
-OP_CONST = 1
+OP_NODE = 1
 OP_MIX_WEIGHT = 2
 OP_CLOSURE = 3
-MAX_REGS = 1024
+OP_COPY = 4
+OP_CONVERT = 5
+MAX_REGS = 1 << 22            # registers of all materials together (32 MiB per worker)
 
-ShadingData = namedtuple("ShadingData", [
-    "px", "py", "pz",          # the point
-    "nx", "ny", "nz",          # unit shading normal (interpolated), on the viewer's side
-    "ngx", "ngy", "ngz",       # unit geometric normal, on the viewer's side
-    "wox", "woy", "woz",       # unit direction to the viewer
-    "backfacing",              # the ray arrived from the inside of the surface
-    "allocate",                # closures are built (False on terminated and shadow paths:
-                               # only emission, transparency and holdout are wanted)
-    "reflective_caustics",     # glossy reflection closures are allowed at this vertex
-    "refractive_caustics",     # refraction closures are allowed at this vertex
-    "bump_correction",         # tilt glossy normals whose mirror direction points inside
-])
+# Implicit conversions of a link (OP_CONVERT c).
+CONV_COLOR_TO_FLOAT = 0       # luminance: dot(c, RGB_TO_Y)
+CONV_VECTOR_TO_FLOAT = 1      # mean of the components
+CONV_FLOAT_TO_VECTOR = 2      # (f, f, f), also to a colour
+# Luminance of the working space (Linear Rec.709): the Y row of its RGB -> XYZ matrix, as
+# Cycles' rgb_to_y reads it from Blender's OCIO configuration.
+RGB_TO_Y = (0.212639, 0.715169, 0.072193)
 
 ShaderResult = namedtuple("ShaderResult", [
     "n",                       # closures written to cl
@@ -52,7 +72,31 @@ ShaderResult = namedtuple("ShaderResult", [
 
 
 @function
-def eval_shader(ops, consts, start, end, regs, cl, sd):
+def eval_node(code, regs, b, c, sd, tex):
+    """Evaluate value node ``code``: inputs at regs[b:], outputs to regs[c:]."""
+    family = code // 100
+    if family == FAMILY_INPUT:
+        eval_input_node(code, regs, b, c, sd, tex)
+    elif family == FAMILY_TEXTURE:
+        eval_texture_node(code, regs, b, c, sd, tex)
+
+
+@device
+def convert(regs, a, b, kind):
+    """OP_CONVERT: regs[a:] = regs[b:] converted (``CONV_*``)."""
+    if kind == CONV_COLOR_TO_FLOAT:
+        regs[a] = RGB_TO_Y[0] * regs[b] + RGB_TO_Y[1] * regs[b + 1] + RGB_TO_Y[2] * regs[b + 2]
+    elif kind == CONV_VECTOR_TO_FLOAT:
+        regs[a] = (regs[b] + regs[b + 1] + regs[b + 2]) * (1.0 / 3.0)
+    else:
+        f = regs[b]
+        regs[a] = f
+        regs[a + 1] = f
+        regs[a + 2] = f
+
+
+@function
+def eval_shader(ops, start, end, regs, cl, sd, tex):
     """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`."""
     n = 0
     er = eg = eb = 0.0
@@ -61,15 +105,7 @@ def eval_shader(ops, consts, start, end, regs, cl, sd):
     for pc in range(start, end):
         op = ops[pc, 0]
         a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
-        if op == OP_CONST:
-            for k in range(c):
-                regs[a + k] = consts[b + k]
-        elif op == OP_MIX_WEIGHT:
-            fac = min(max(regs[a], 0.0), 1.0)
-            w = regs[b] if b >= 0 else 1.0
-            regs[c] = w * (1.0 - fac)
-            regs[c + 1] = w * fac
-        elif op == OP_CLOSURE:
+        if op == OP_CLOSURE:
             w = regs[c] if c >= 0 else 1.0
             if w == 0.0:
                 continue
@@ -81,4 +117,16 @@ def eval_shader(ops, consts, start, end, regs, cl, sd):
             tg += dtg
             tb += dtb
             holdout += dh
+        elif op == OP_NODE:
+            eval_node(a, regs, b, c, sd, tex)
+        elif op == OP_COPY:
+            for k in range(c):
+                regs[a + k] = regs[b + k]
+        elif op == OP_CONVERT:
+            convert(regs, a, b, c)
+        elif op == OP_MIX_WEIGHT:
+            fac = min(max(regs[a], 0.0), 1.0)
+            w = regs[b] if b >= 0 else 1.0
+            regs[c] = w * (1.0 - fac)
+            regs[c + 1] = w * fac
     return ShaderResult(n, er, eg, eb, tr, tg, tb, holdout)

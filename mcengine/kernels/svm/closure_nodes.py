@@ -23,6 +23,7 @@ from ..closures import microfacet as mf
 from ..closures.diffuse import oren_nayar_setup
 from ..closures.fresnel import F0_from_ior, ior_from_F0
 from ..closures.layout import (
+    CL_ALBEDO,
     CL_AX,
     CL_AY,
     CL_DIST,
@@ -57,7 +58,7 @@ from ..closures.layout import (
 from ..closures.sheen import sheen_setup
 from ..sampling import orthonormal_basis
 from .nodes import (
-    COLOR,
+    COLOR_IN,
     D_NORMAL,
     D_ROUGHNESS,
     DIST_BECKMANN,
@@ -243,11 +244,6 @@ def microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy):
     mf.microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy)
 
 
-@function
-def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
-    return mf.microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission)
-
-
 @device
 def microfacet(cl, k, ctype, distribution, ax, ay, eta, nx, ny, nz, tx, ty, tz, sd):
     """Fill the microfacet part of closure k (Fresnel FR_NONE until a setup below);
@@ -275,12 +271,15 @@ def schlick(cl, k, cos_no, f0r, f0g, f0b, exponent, rtr, rtg, rtb, ttr, ttg, ttb
 
 
 @device
-def layer_weight(cl, k, cos_no, wr, wg, wb):
-    """Weight left for the closures below layer k (Cycles' closure_layering_weight)."""
-    ar, ag, ab = microfacet_albedo(cl, k, cos_no, True, False)
-    ar *= cl[k, CL_W]
-    ag *= cl[k, CL_W + 1]
-    ab *= cl[k, CL_W + 2]
+def layer_weight(cl, k, wr, wg, wb):
+    """Weight left for the closures below layer k (Cycles' closure_layering_weight).
+
+    Layer k is a reflection-only microfacet closure whose Fresnel setup stored its albedo
+    estimate at the view in CL_ALBEDO (reflection only: the transmission part is zero).
+    """
+    ar = cl[k, CL_ALBEDO] * cl[k, CL_W]
+    ag = cl[k, CL_ALBEDO + 1] * cl[k, CL_W + 1]
+    ab = cl[k, CL_ALBEDO + 2] * cl[k, CL_W + 2]
     return _attenuate(ar, ag, ab, wr, wg, wb)
 
 
@@ -306,7 +305,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
     """
     if kind == K_PRINCIPLED:
         return principled(regs, b, w, cl, n, sd)
-    cr, cg, cb = regs[b + COLOR] * w, regs[b + COLOR + 1] * w, regs[b + COLOR + 2] * w
+    cr, cg, cb = regs[b + COLOR_IN] * w, regs[b + COLOR_IN + 1] * w, regs[b + COLOR_IN + 2] * w
     if kind == K_EMISSION:
         s = regs[b + E_STRENGTH]
         return n, cr * s, cg * s, cb * s, 0.0, 0.0, 0.0, 0.0
@@ -320,7 +319,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         if k >= 0:
             nx, ny, nz = input_normal(regs, b + D_NORMAL, sd)
             diffuse(cl, k, sd, nx, ny, nz, regs[b + D_ROUGHNESS],
-                    sat(regs[b + COLOR]), sat(regs[b + COLOR + 1]), sat(regs[b + COLOR + 2]))
+                    sat(regs[b + COLOR_IN]), sat(regs[b + COLOR_IN + 1]), sat(regs[b + COLOR_IN + 2]))
     elif kind == K_TRANSLUCENT:
         k, n = alloc(cl, n, cr, cg, cb, sd)
         if k >= 0:
@@ -423,8 +422,8 @@ def glossy(regs, b, cl, n, sd, cr, cg, cb):
     dist = regs[b + G_DISTRIBUTION]
     cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, 1.0, nx, ny, nz, tx, ty, tz, sd)
     if dist == DIST_MULTI_GGX:
-        microfacet_setup_fresnel_constant(cl, k, cos_no, max(regs[b + COLOR], 0.0),
-                                          max(regs[b + COLOR + 1], 0.0), max(regs[b + COLOR + 2], 0.0))
+        microfacet_setup_fresnel_constant(cl, k, cos_no, max(regs[b + COLOR_IN], 0.0),
+                                          max(regs[b + COLOR_IN + 1], 0.0), max(regs[b + COLOR_IN + 2], 0.0))
     return n
 
 
@@ -445,7 +444,7 @@ def glass(regs, b, w, cl, n, sd):
     dist = regs[b + GL_DISTRIBUTION]
     cos_no = microfacet(cl, k, CT_MICROFACET_GLASS, dist, a, a, 1.0 / ior if sd.backfacing else ior,
                         nx, ny, nz, 0.0, 0.0, 0.0, sd)
-    cr, cg, cb = max(regs[b + COLOR], 0.0), max(regs[b + COLOR + 1], 0.0), max(regs[b + COLOR + 2], 0.0)
+    cr, cg, cb = max(regs[b + COLOR_IN], 0.0), max(regs[b + COLOR_IN + 1], 0.0), max(regs[b + COLOR_IN + 2], 0.0)
     f0 = F0_from_ior(ior)
     schlick(cl, k, cos_no, f0, f0, f0, -ior,
             cr if refl else 0.0, cg if refl else 0.0, cb if refl else 0.0,
@@ -537,7 +536,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
                 cos_no = microfacet(cl, k, CT_MICROFACET, 0.0, ca, ca, coat_ior, vcx, vcy, vcz,
                                     0.0, 0.0, 0.0, sd)
                 microfacet_setup_fresnel_dielectric(cl, k, cos_no)
-                wr, wg, wb = layer_weight(cl, k, cos_no, wr, wg, wb)
+                wr, wg, wb = layer_weight(cl, k, wr, wg, wb)
         ct_r = max(regs[b + P_COAT_TINT], 0.0)
         ct_g = max(regs[b + P_COAT_TINT + 1], 0.0)
         ct_b = max(regs[b + P_COAT_TINT + 2], 0.0)
@@ -597,7 +596,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
             cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, eta, rnx, rny, rnz, tx, ty, tz, sd)
             schlick(cl, k, cos_no, f0 * st_r, f0 * st_g, f0 * st_b, -eta, 1.0, 1.0, 1.0,
                     0.0, 0.0, 0.0, multiscatter)
-            wr, wg, wb = layer_weight(cl, k, cos_no, wr, wg, wb)
+            wr, wg, wb = layer_weight(cl, k, wr, wg, wb)
 
     # Subsurface: Cycles' own zero-radius limit, a Lambert closure of the clamped colour.
     if subsurface > CLOSURE_WEIGHT_CUTOFF:

@@ -1,16 +1,46 @@
-"""The shader nodes the evaluator knows: their inputs, defaults and parameter layout.
+"""The shader nodes the evaluator knows: their sockets, defaults and register layout.
 
 This is the one vocabulary shared by the compiler (``mcengine.shaders``, which
 lays a node's inputs out in consecutive registers) and the evaluator (which
 reads them back by offset).  Names are Blender's: node types without the
-``ShaderNode`` prefix, input sockets by identifier (the Mix Shader's second
-shader input is ``Shader_001``).  Defaults are Blender 5.0's.
+``ShaderNode`` prefix, sockets by identifier (the Mix Shader's second shader
+input is ``Shader_001``, the Math node's inputs ``Value``, ``Value_001``,
+``Value_002``).  Defaults are Blender 5.0's.
 
-A node's enum properties become numeric inputs too (``distribution`` as a
-``DIST_*`` code), so that every parameter of a closure travels the same way
-and can later come from a texture.
+Every socket has a type: ``float`` (1 register), ``color`` and ``vector``
+(3), ``shader`` (none: closures travel by weight, not through registers).
+A node's properties become inputs too, named ``prop:<name>``: enum properties
+as the numeric codes of ``ENUMS``, flags as 0/1, numbers as they are; a
+``table`` property (a ColorRamp's stops, a curve's samples) is a count
+followed by its values and must be the node's last input; a ``matrix`` is an
+affine transform's 3 x 4 rows (12 registers).  So every
+parameter travels the same way, and a constant costs nothing at a hit: the
+compiler stores constants in the registers once per render.
+
+Node codes: closures 1-99 (``OP_CLOSURE``); other nodes are grouped in
+families of a hundred (``family = code // 100``), each evaluated by one
+module of this package (``FAMILY_*``).
 """
 from __future__ import annotations
+
+from collections import namedtuple
+
+FLOAT = "float"
+COLOR = "color"
+VECTOR = "vector"
+SHADER = "shader"
+TABLE = "table"
+MATRIX = "matrix"
+SIZE = {FLOAT: 1, COLOR: 3, VECTOR: 3, SHADER: 0, TABLE: 0, MATRIX: 12}
+
+Socket = namedtuple("Socket", ["name", "type", "default"])
+NodeSpec = namedtuple("NodeSpec", [
+    "code",       # OP_CLOSURE kind (closures) or OP_NODE code (family * 100 + n)
+    "inputs",     # tuple of Socket, in register order
+    "outputs",    # tuple of Socket (default unused), in register order
+    "pure",       # output depends on the inputs only (no shading point, no image): the compiler
+                  # evaluates it ahead of time when every input is constant
+])
 
 # Distributions of the microfacet nodes (the ``distribution`` property).
 DIST_GGX = 0
@@ -20,54 +50,132 @@ DIST_ASHIKHMIN_SHIRLEY = 3
 DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_BECKMANN,
                  "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY}
 
+# Enum properties: property name -> {Blender's identifier: code}.  A node's enum inputs
+# ("prop:<name>") are encoded with the table of that name.
+ENUMS = {
+    "distribution": DISTRIBUTIONS,
+}
+
 WHITE = (1.0, 1.0, 1.0)
 GREY = (0.8, 0.8, 0.8)
 UNLINKED = (0.0, 0.0, 0.0)   # a Normal or Tangent input nothing is linked to: the geometry's
+IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)   # a 3 x 4 matrix
 
-# Closure nodes: kind code and inputs (identifier, components, default).  A property
-# appears as ("prop:<name>", 1, default code).
-NODES = {
-    "BsdfPrincipled": (1, (
-        ("Base Color", 3, GREY), ("Metallic", 1, 0.0), ("Roughness", 1, 0.5), ("IOR", 1, 1.5),
-        ("Alpha", 1, 1.0), ("Normal", 3, UNLINKED), ("Diffuse Roughness", 1, 0.0),
-        ("Subsurface Weight", 1, 0.0), ("Subsurface Radius", 3, (1.0, 0.2, 0.1)),
-        ("Subsurface Scale", 1, 0.05), ("Specular IOR Level", 1, 0.5), ("Specular Tint", 3, WHITE),
-        ("Anisotropic", 1, 0.0), ("Anisotropic Rotation", 1, 0.0), ("Tangent", 3, UNLINKED),
-        ("Transmission Weight", 1, 0.0), ("Coat Weight", 1, 0.0), ("Coat Roughness", 1, 0.03),
-        ("Coat IOR", 1, 1.5), ("Coat Tint", 3, WHITE), ("Coat Normal", 3, UNLINKED),
-        ("Sheen Weight", 1, 0.0), ("Sheen Roughness", 1, 0.5), ("Sheen Tint", 3, WHITE),
-        ("Emission Color", 3, WHITE), ("Emission Strength", 1, 0.0),
-        ("Thin Film Thickness", 1, 0.0), ("Thin Film IOR", 1, 1.33),
-        ("prop:distribution", 1, DIST_MULTI_GGX))),
-    "BsdfDiffuse": (2, (("Color", 3, GREY), ("Roughness", 1, 0.0), ("Normal", 3, UNLINKED))),
-    "BsdfGlossy": (3, (("Color", 3, GREY), ("Roughness", 1, 0.5), ("Anisotropy", 1, 0.0),
-                       ("Rotation", 1, 0.0), ("Normal", 3, UNLINKED), ("Tangent", 3, UNLINKED),
-                       ("prop:distribution", 1, DIST_MULTI_GGX))),
-    "BsdfGlass": (4, (("Color", 3, WHITE), ("Roughness", 1, 0.0), ("IOR", 1, 1.5),
-                      ("Normal", 3, UNLINKED), ("Thin Film Thickness", 1, 0.0),
-                      ("Thin Film IOR", 1, 1.33), ("prop:distribution", 1, DIST_MULTI_GGX))),
-    "BsdfRefraction": (5, (("Color", 3, WHITE), ("Roughness", 1, 0.0), ("IOR", 1, 1.45),
-                           ("Normal", 3, UNLINKED), ("prop:distribution", 1, DIST_BECKMANN))),
-    "BsdfTranslucent": (6, (("Color", 3, GREY), ("Normal", 3, UNLINKED))),
-    "BsdfTransparent": (7, (("Color", 3, WHITE),)),
-    "BsdfSheen": (8, (("Color", 3, GREY), ("Roughness", 1, 0.5), ("Normal", 3, UNLINKED))),
-    "Emission": (9, (("Color", 3, WHITE), ("Strength", 1, 1.0))),
-    "Holdout": (10, ()),
+# Defaults of texture coordinate inputs that Cycles fills from the shading point when
+# nothing is linked (the compiler links a Texture Coordinate output there instead).
+GENERATED = "generated"
+UV = "uv"
+IMPLICIT = {GENERATED: "Generated", UV: "UV"}
+
+
+def _f(name, default):
+    return Socket(name, FLOAT, float(default))
+
+
+def _c(name, default):
+    return Socket(name, COLOR, tuple(float(v) for v in default))
+
+
+def _v(name, default=UNLINKED):
+    return Socket(name, VECTOR, default if isinstance(default, str) else tuple(map(float, default)))
+
+
+def _p(name, default):
+    return Socket("prop:" + name, FLOAT, float(default))
+
+
+_BSDF = (Socket("BSDF", SHADER, None),)
+
+# -- closure nodes (kernel/svm/closure.h) ---------------------------------------------------------
+CLOSURES = {
+    "BsdfPrincipled": NodeSpec(1, (
+        _c("Base Color", GREY), _f("Metallic", 0.0), _f("Roughness", 0.5), _f("IOR", 1.5),
+        _f("Alpha", 1.0), _v("Normal"), _f("Diffuse Roughness", 0.0),
+        _f("Subsurface Weight", 0.0), _v("Subsurface Radius", (1.0, 0.2, 0.1)),
+        _f("Subsurface Scale", 0.05), _f("Specular IOR Level", 0.5), _c("Specular Tint", WHITE),
+        _f("Anisotropic", 0.0), _f("Anisotropic Rotation", 0.0), _v("Tangent"),
+        _f("Transmission Weight", 0.0), _f("Coat Weight", 0.0), _f("Coat Roughness", 0.03),
+        _f("Coat IOR", 1.5), _c("Coat Tint", WHITE), _v("Coat Normal"),
+        _f("Sheen Weight", 0.0), _f("Sheen Roughness", 0.5), _c("Sheen Tint", WHITE),
+        _c("Emission Color", WHITE), _f("Emission Strength", 0.0),
+        _f("Thin Film Thickness", 0.0), _f("Thin Film IOR", 1.33),
+        _p("distribution", DIST_MULTI_GGX)), _BSDF, False),
+    "BsdfDiffuse": NodeSpec(2, (_c("Color", GREY), _f("Roughness", 0.0), _v("Normal")), _BSDF, False),
+    "BsdfGlossy": NodeSpec(3, (_c("Color", GREY), _f("Roughness", 0.5), _f("Anisotropy", 0.0),
+                               _f("Rotation", 0.0), _v("Normal"), _v("Tangent"),
+                               _p("distribution", DIST_MULTI_GGX)), _BSDF, False),
+    "BsdfGlass": NodeSpec(4, (_c("Color", WHITE), _f("Roughness", 0.0), _f("IOR", 1.5),
+                              _v("Normal"), _f("Thin Film Thickness", 0.0),
+                              _f("Thin Film IOR", 1.33), _p("distribution", DIST_MULTI_GGX)),
+                          _BSDF, False),
+    "BsdfRefraction": NodeSpec(5, (_c("Color", WHITE), _f("Roughness", 0.0), _f("IOR", 1.45),
+                                   _v("Normal"), _p("distribution", DIST_BECKMANN)), _BSDF, False),
+    "BsdfTranslucent": NodeSpec(6, (_c("Color", GREY), _v("Normal")), _BSDF, False),
+    "BsdfTransparent": NodeSpec(7, (_c("Color", WHITE),), _BSDF, False),
+    "BsdfSheen": NodeSpec(8, (_c("Color", GREY), _f("Roughness", 0.5), _v("Normal")), _BSDF, False),
+    "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
+                         (Socket("Emission", SHADER, None),), False),
+    "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
 }
-KIND = {name: kind for name, (kind, _inputs) in NODES.items()}
-INPUTS = {name: inputs for name, (_kind, inputs) in NODES.items()}
+
+# Nodes that only route closures.
+SHADER_ROUTING = {
+    "MixShader": NodeSpec(0, (_f("Fac", 0.5), Socket("Shader", SHADER, None),
+                              Socket("Shader_001", SHADER, None)), (Socket("Shader", SHADER, None),),
+                          False),
+    "AddShader": NodeSpec(0, (Socket("Shader", SHADER, None), Socket("Shader_001", SHADER, None)),
+                          (Socket("Shader", SHADER, None),), False),
+}
+
+# -- value nodes: families ------------------------------------------------------------------------
+FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, constants
+FAMILY_MATH = 2        # svm/math_nodes.py: Math, Vector Math, Map Range, converters
+FAMILY_COLOR = 3       # svm/color_nodes.py: Mix, ColorRamp, curves, colour adjustments
+FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural and image textures
+FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Normal Map, Bump, Vector Transform
+
+# Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
+# of the single-output coordinate nodes the compiler inserts for implicit inputs).
+TEX_COORD_OUTPUTS = ("Generated", "Normal", "UV", "Object", "Camera", "Window", "Reflection")
+
+VALUE_NODES = {
+    # -- input family
+    "Value": NodeSpec(101, (_f("prop:value", 0.0),), (_f("Value", 0.0),), True),
+    "RGB": NodeSpec(102, (_c("prop:color", (0.5, 0.5, 0.5)),), (_c("Color", (0, 0, 0)),), True),
+    "TexCoord": NodeSpec(103, (_p("use_object", 0), Socket("prop:object_inverse", MATRIX, IDENTITY)),
+                         tuple(_v(name, UNLINKED) for name in TEX_COORD_OUTPUTS), False),
+    "UVMap": NodeSpec(104, (_p("attribute", -1),), (_v("UV", UNLINKED),), False),
+    "Attribute": NodeSpec(105, (_p("attribute", -1), _p("attribute_size", 0)),
+                          (_c("Color", (0, 0, 0)), _v("Vector", UNLINKED), _f("Fac", 0.0),
+                           _f("Alpha", 0.0)), False),
+    "NewGeometry": NodeSpec(106, (), (_v("Position"), _v("Normal"), _v("Tangent"),
+                                      _v("True Normal"), _v("Incoming"), _v("Parametric"),
+                                      _f("Backfacing", 0.0), _f("Pointiness", 0.0),
+                                      _f("Random Per Island", 0.0)), False),
+    # -- texture family
+    "TexChecker": NodeSpec(401, (_v("Vector", GENERATED), _c("Color1", (0.8, 0.8, 0.8)),
+                                 _c("Color2", (0.2, 0.2, 0.2)), _f("Scale", 5.0)),
+                           (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+}
+
+NODES = {**CLOSURES, **VALUE_NODES}
+KIND = {name: spec.code for name, spec in CLOSURES.items()}
+INPUTS = {name: spec.inputs for name, spec in NODES.items()}
+OUTPUTS = {name: spec.outputs for name, spec in NODES.items()}
 
 
-def _layout(inputs) -> dict:
+def _layout(sockets) -> dict:
     offsets, k = {}, 0
-    for name, size, _default in inputs:
-        offsets[name] = k
-        k += size
+    for socket in sockets:
+        offsets[socket.name] = k
+        k += SIZE[socket.type]
     return offsets
 
 
-OFFSETS = {name: _layout(inputs) for name, inputs in INPUTS.items()}
-SIZES = {name: sum(size for _n, size, _d in inputs) for name, inputs in INPUTS.items()}
+OFFSETS = {name: _layout(spec.inputs) for name, spec in NODES.items()}
+OUTPUT_OFFSETS = {name: _layout(spec.outputs) for name, spec in NODES.items()}
+SIZES = {name: sum(SIZE[s.type] for s in spec.inputs) for name, spec in NODES.items()}
+OUTPUT_SIZES = {name: sum(SIZE[s.type] for s in spec.outputs) for name, spec in NODES.items()}
 
 # Register offsets the evaluator reads (numba freezes these module constants).
 _P = OFFSETS["BsdfPrincipled"]
@@ -99,7 +207,7 @@ P_THIN_FILM = _P["Thin Film Thickness"]
 P_DISTRIBUTION = _P["prop:distribution"]
 
 # The other nodes share one layout idea: colour first, then their own inputs.
-COLOR = 0                       # every BSDF node but the Principled: "Color" at offset 0
+COLOR_IN = 0                    # every BSDF node but the Principled: "Color" at offset 0
 D_ROUGHNESS = OFFSETS["BsdfDiffuse"]["Roughness"]
 D_NORMAL = OFFSETS["BsdfDiffuse"]["Normal"]
 G_ROUGHNESS = OFFSETS["BsdfGlossy"]["Roughness"]
@@ -133,5 +241,3 @@ K_SHEEN = KIND["BsdfSheen"]
 K_EMISSION = KIND["Emission"]
 K_HOLDOUT = KIND["Holdout"]
 
-# Nodes that only route closures.
-SHADER_ROUTING = ("MixShader", "AddShader")

@@ -1,0 +1,174 @@
+"""Input nodes: what the shading point offers the graph (kernel/svm/tex_coord.h, geometry.h,
+attribute.h, value.h).
+
+Texture Coordinate, UV Map, Attribute and Geometry read the point
+(``ShadingData``) and the scene's per-corner attributes and per-object data
+(``TextureData``); Value and RGB are constants (the compiler folds them, so
+they only run here when evaluated ahead of time).  Every output of a node is
+computed, each into its registers (``nodes.OUTPUT_OFFSETS``).
+"""
+from __future__ import annotations
+
+import math
+
+from ...jit import device, function
+from ..camera import C_FWD, C_HALF_H, C_HALF_W, C_POS, C_RIGHT, C_SHIFT_X, C_SHIFT_Y, C_TYPE, C_UP, CAM_ORTHO
+from .data import ATTR_DEFAULT_UV, OBJ_INVERSE, OBJ_MATRIX, OBJ_TEXSPACE_LOC, OBJ_TEXSPACE_SIZE
+from .nodes import NODES, OFFSETS
+
+_VALUE = NODES["Value"].code
+_RGB = NODES["RGB"].code
+_TEX_COORD = NODES["TexCoord"].code
+_UV_MAP = NODES["UVMap"].code
+_ATTRIBUTE = NODES["Attribute"].code
+_GEOMETRY = NODES["NewGeometry"].code
+_TC_USE_OBJECT = OFFSETS["TexCoord"]["prop:use_object"]
+_TC_INVERSE = OFFSETS["TexCoord"]["prop:object_inverse"]
+_UV_ATTRIBUTE = OFFSETS["UVMap"]["prop:attribute"]
+_ATTR_OFFSET = OFFSETS["Attribute"]["prop:attribute"]
+_ATTR_SIZE = OFFSETS["Attribute"]["prop:attribute_size"]
+
+
+@function
+def eval_input_node(code, regs, b, c, sd, tex):
+    if code == _TEX_COORD:
+        tex_coord(regs, b, c, sd, tex)
+    elif code == _UV_MAP:
+        off = int(regs[b + _UV_ATTRIBUTE])
+        x, y, _z, _w = attribute(tex, sd, off, 2)
+        regs[c], regs[c + 1], regs[c + 2] = x, y, 0.0
+    elif code == _ATTRIBUTE:
+        attribute_node(regs, b, c, sd, tex)
+    elif code == _GEOMETRY:
+        geometry(regs, c, sd)
+    elif code == _VALUE:
+        regs[c] = regs[b]
+    elif code == _RGB:
+        regs[c], regs[c + 1], regs[c + 2] = regs[b], regs[b + 1], regs[b + 2]
+
+
+@device
+def attribute(tex, sd, off, size):
+    """Per-corner attribute at offset ``off`` (``size`` components, at most 4) interpolated
+    at the point; zeros without a triangle or when the scene has no such attribute."""
+    x = y = z = w = 0.0
+    p = sd.prim
+    if p < 0 or off < 0:
+        return x, y, z, w
+    b0, b1, b2 = 1.0 - sd.u - sd.v, sd.u, sd.v
+    a = tex.attr
+    x = b0 * float(a[p, 0, off]) + b1 * float(a[p, 1, off]) + b2 * float(a[p, 2, off])
+    if size > 1:
+        y = b0 * float(a[p, 0, off + 1]) + b1 * float(a[p, 1, off + 1]) + b2 * float(a[p, 2, off + 1])
+    if size > 2:
+        z = b0 * float(a[p, 0, off + 2]) + b1 * float(a[p, 1, off + 2]) + b2 * float(a[p, 2, off + 2])
+    if size > 3:
+        w = b0 * float(a[p, 0, off + 3]) + b1 * float(a[p, 1, off + 3]) + b2 * float(a[p, 2, off + 3])
+    return x, y, z, w
+
+
+@device
+def _store3(regs, c, x, y, z):
+    regs[c], regs[c + 1], regs[c + 2] = x, y, z
+
+
+@device
+def transform_point(m, o, x, y, z):
+    """Row-major 3 x 4 matrix at m[o:o + 12] applied to a point."""
+    return (m[o] * x + m[o + 1] * y + m[o + 2] * z + m[o + 3],
+            m[o + 4] * x + m[o + 5] * y + m[o + 6] * z + m[o + 7],
+            m[o + 8] * x + m[o + 9] * y + m[o + 10] * z + m[o + 11])
+
+
+@device
+def _normalize(x, y, z):
+    ln = math.sqrt(x * x + y * y + z * z)
+    if ln > 0.0:
+        return x / ln, y / ln, z / ln
+    return x, y, z
+
+
+@device
+def tex_coord(regs, b, c, sd, tex):
+    """Texture Coordinate: Generated, Normal, UV, Object, Camera, Window, Reflection."""
+    px, py, pz = sd.px, sd.py, sd.pz
+    nx, ny, nz = sd.nx, sd.ny, sd.nz
+    ob = sd.obj
+    objects = tex.objects
+    # Generated: the object-space point in the object's texture space (world: the direction).
+    gx, gy, gz = px, py, pz
+    onx, ony, onz = nx, ny, nz
+    ox, oy, oz = px, py, pz
+    if ob >= 0 and sd.prim >= 0:
+        row = objects[ob]
+        ox, oy, oz = transform_point(row, OBJ_INVERSE, px, py, pz)
+        lx, ly, lz = row[OBJ_TEXSPACE_LOC], row[OBJ_TEXSPACE_LOC + 1], row[OBJ_TEXSPACE_LOC + 2]
+        sx, sy, sz = row[OBJ_TEXSPACE_SIZE], row[OBJ_TEXSPACE_SIZE + 1], row[OBJ_TEXSPACE_SIZE + 2]
+        gx = (ox - lx) / (2.0 * sx) + 0.5
+        gy = (oy - ly) / (2.0 * sy) + 0.5
+        gz = (oz - lz) / (2.0 * sz) + 0.5
+        # Normals go to object space by the transpose of the object -> world matrix.
+        m = OBJ_MATRIX
+        onx, ony, onz = _normalize(row[m] * nx + row[m + 4] * ny + row[m + 8] * nz,
+                                   row[m + 1] * nx + row[m + 5] * ny + row[m + 9] * nz,
+                                   row[m + 2] * nx + row[m + 6] * ny + row[m + 10] * nz)
+    if regs[b + _TC_USE_OBJECT] != 0.0:
+        ox, oy, oz = transform_point(regs, b + _TC_INVERSE, px, py, pz)
+    u, v, _z, _w = attribute(tex, sd, ATTR_DEFAULT_UV, 2)
+    # Camera space: +X right, +Y up, +Z forward, from the camera's position.
+    cam = tex.camera
+    dx, dy, dz = px - cam[C_POS], py - cam[C_POS + 1], pz - cam[C_POS + 2]
+    cx = dx * cam[C_RIGHT] + dy * cam[C_RIGHT + 1] + dz * cam[C_RIGHT + 2]
+    cy = dx * cam[C_UP] + dy * cam[C_UP + 1] + dz * cam[C_UP + 2]
+    cz = dx * cam[C_FWD] + dy * cam[C_FWD + 1] + dz * cam[C_FWD + 2]
+    # Window: normalized device coordinates, (0, 0) bottom left, (1, 1) top right.
+    if cam[C_TYPE] == CAM_ORTHO:
+        vx, vy = cx, cy
+    else:
+        vx, vy = (cx / cz, cy / cz) if cz != 0.0 else (0.0, 0.0)
+    wx = 0.5 * ((vx - cam[C_SHIFT_X]) / cam[C_HALF_W] + 1.0)
+    wy = 0.5 * ((vy - cam[C_SHIFT_Y]) / cam[C_HALF_H] + 1.0)
+    # Reflection of the direction to the viewer about the normal (world: that direction).
+    wox, woy, woz = sd.wox, sd.woy, sd.woz
+    rx, ry, rz = wox, woy, woz
+    if sd.prim >= 0:
+        d = 2.0 * (nx * wox + ny * woy + nz * woz)
+        rx, ry, rz = d * nx - wox, d * ny - woy, d * nz - woz
+    _store3(regs, c, gx, gy, gz)
+    _store3(regs, c + 3, onx, ony, onz)
+    _store3(regs, c + 6, u, v, 0.0)
+    _store3(regs, c + 9, ox, oy, oz)
+    _store3(regs, c + 12, cx, cy, cz)
+    _store3(regs, c + 15, wx, wy, 0.0)
+    _store3(regs, c + 18, rx, ry, rz)
+
+
+@device
+def attribute_node(regs, b, c, sd, tex):
+    """Attribute (geometry type): Color, Vector, Fac, Alpha of a per-corner attribute."""
+    off = int(regs[b + _ATTR_OFFSET])
+    size = int(regs[b + _ATTR_SIZE])
+    x, y, z, w = attribute(tex, sd, off, size)
+    if size == 1:
+        y = z = x
+    alpha = w if size == 4 else 1.0
+    fac = x if size == 1 else (x + y + z) / 3.0
+    if off < 0 or sd.prim < 0:
+        alpha = 0.0
+    regs[c], regs[c + 1], regs[c + 2] = x, y, z
+    regs[c + 3], regs[c + 4], regs[c + 5] = x, y, z
+    regs[c + 6] = fac
+    regs[c + 7] = alpha
+
+
+@device
+def geometry(regs, c, sd):
+    """Geometry: Position, Normal, Tangent (not yet: zero), True Normal, Incoming, Parametric,
+    Backfacing, Pointiness (not yet: 0.5) and Random Per Island (not yet: 0)."""
+    _store3(regs, c, sd.px, sd.py, sd.pz)
+    _store3(regs, c + 3, sd.nx, sd.ny, sd.nz)
+    _store3(regs, c + 6, 0.0, 0.0, 0.0)
+    _store3(regs, c + 9, sd.ngx, sd.ngy, sd.ngz)
+    _store3(regs, c + 12, sd.wox, sd.woy, sd.woz)
+    _store3(regs, c + 15, 1.0 - sd.u - sd.v, sd.u, 0.0)
+    _store3(regs, c + 18, 1.0 if sd.backfacing else 0.0, 0.5, 0.0)

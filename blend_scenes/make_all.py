@@ -31,6 +31,8 @@ SCENES = (
     "camera_sensor_fit",
     "camera_portrait_wide",
     "camera_ortho",
+    "camera_dof",
+    "camera_dof_ortho",
     "material_principled",
     "material_nodes",
     "material_suzanne",

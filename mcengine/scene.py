@@ -39,6 +39,7 @@ MAX_RESOLUTION = 65536          # pixels per side, Blender's own limit
 MAX_SAMPLES = 1 << 24           # Cycles' limit
 MAX_BOUNCES = 1024
 MIN_FILTER_WIDTH = float(np.float32(0.01))   # pixels, Blender's own limit (stored as float32)
+MAX_BLADES = 100000             # aperture blades; beyond, a polygon is a disk to float precision
 PI_FLOAT32 = float(np.float32(np.pi))
 AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
@@ -307,7 +308,15 @@ class Light:
 
 @dataclass
 class Camera:
-    """Blender camera data plus its world matrix (looks along local -Z, +Y up)."""
+    """Blender camera data plus its world matrix (looks along local -Z, +Y up).
+
+    Depth of field is described as Cycles' own camera describes it: a lens of
+    radius ``aperture_size`` (metres; 0 is a pinhole camera) focused on the
+    plane ``focal_distance`` metres in front of it, a disk or, with
+    ``aperture_blades`` >= 3, a regular polygon turned by ``aperture_rotation``
+    (radians), squeezed horizontally by ``aperture_ratio`` (anamorphic bokeh).
+    The exporter derives them from Blender's f-stop, as Cycles does.
+    """
 
     matrix_world: np.ndarray = field(default_factory=lambda: np.eye(4))
     type: str = "PERSP"              # 'PERSP' or 'ORTHO'
@@ -320,6 +329,11 @@ class Camera:
     ortho_scale: float = 6.0
     clip_start: float = 0.1
     clip_end: float = 1000.0
+    aperture_size: float = 0.0       # lens radius, m (0: no depth of field)
+    focal_distance: float = 10.0     # distance of the plane in focus along the view axis, m
+    aperture_blades: int = 0         # polygonal aperture with this many blades (< 3: a disk)
+    aperture_rotation: float = 0.0   # rotation of the polygon, radians
+    aperture_ratio: float = 1.0      # anamorphic squeeze: lens x is divided by it
 
 
 @dataclass
@@ -487,6 +501,11 @@ class SceneDescription:
         _check_number("camera", "clip_end", c.clip_end, lo=c.clip_start + 1e-12)
         if c.sensor_fit not in ("AUTO", "HORIZONTAL", "VERTICAL"):
             raise SceneError(f"camera: unknown sensor_fit {c.sensor_fit!r} (AUTO, HORIZONTAL, VERTICAL)")
+        _check_number("camera", "aperture_size", c.aperture_size, lo=0.0)
+        _check_number("camera", "focal_distance", c.focal_distance, lo=0.0)
+        _check_number("camera", "aperture_blades", c.aperture_blades, lo=0, hi=MAX_BLADES)
+        _check_number("camera", "aperture_rotation", c.aperture_rotation)
+        _check_number("camera", "aperture_ratio", c.aperture_ratio, lo=1e-6)
         i = self.integrator
         try:
             integrators.get(i.name)

@@ -5,6 +5,13 @@ Camera: perspective and orthographic cameras (panoramic ones raise
 object scale removed (Cycles ignores camera scale), translation in metres;
 clip distances and the orthographic scale are converted to metres too.
 
+Depth of field as Cycles' Blender sync computes it (blender/camera.cpp): the
+aperture radius is ``lens x 1e-3 / (2 f-stop)`` (``1 / (2 f-stop)`` for an
+orthographic camera) in scene units, the f-stop at least 1e-5; the focal
+distance is ``dof.focus_distance``, or with a focus object (and bone) the
+depth of that object's origin along the camera's view axis.  Both become
+metres with the unit scale.  With ``dof.use_dof`` off the camera is a pinhole.
+
 Film: the frame is ``resolution x percentage / 100`` pixels (integer division,
 as Blender does).  With ``render.use_border`` the rendered region is Blender's
 border rectangle, computed exactly as Blender rounds it (float32 fraction x
@@ -22,7 +29,10 @@ from mcengine.scene import Camera, Film
 from . import ExportError
 from .settings import cycles_settings
 
-__all__ = ["export_camera", "camera_from_view", "export_film", "frame_size", "border_region"]
+__all__ = ["export_camera", "camera_from_view", "export_film", "frame_size", "border_region",
+           "focal_distance"]
+
+MIN_FSTOP = 1e-5     # Cycles clamps the f-stop to this before dividing by it
 
 
 def export_camera(ctx, depsgraph) -> Camera:
@@ -36,11 +46,8 @@ def export_camera(ctx, depsgraph) -> Camera:
         kind = "panoramic" if cam.type == "PANO" else f"of type {cam.type}"
         raise ExportError(f"camera '{ob.name}' is {kind}; MC Engine renders perspective and "
                           f"orthographic cameras only")
-    if cam.dof.use_dof:
-        ctx.warn(f"camera '{ob.name}': depth of field not supported yet; rendered as a pinhole "
-                 f"camera", "depth of field")
     s = ctx.unit_scale
-    return Camera(
+    camera = Camera(
         matrix_world=_without_scale(np.array(ob.matrix_world, np.float64), s),
         type=cam.type,
         lens=float(cam.lens),
@@ -53,6 +60,37 @@ def export_camera(ctx, depsgraph) -> Camera:
         clip_start=float(cam.clip_start) * s,
         clip_end=float(cam.clip_end) * s,
     )
+    dof = cam.dof
+    if dof.use_dof:
+        fstop = max(float(dof.aperture_fstop), MIN_FSTOP)
+        unit_aperture = 1.0 if cam.type == "ORTHO" else float(cam.lens) * 1e-3
+        camera.aperture_size = unit_aperture / (2.0 * fstop) * s
+        camera.focal_distance = focal_distance(ob, dof, depsgraph) * s
+        camera.aperture_blades = int(dof.aperture_blades)
+        camera.aperture_rotation = float(dof.aperture_rotation)
+        camera.aperture_ratio = float(dof.aperture_ratio)
+    return camera
+
+
+def focal_distance(ob, dof, depsgraph) -> float:
+    """Distance of the plane in focus, in scene units, as Cycles computes it.
+
+    Without a focus object it is ``dof.focus_distance``; with one, the absolute
+    depth of the object's origin (or of its ``focus_subtarget`` bone's head)
+    along the camera's view axis.
+    """
+    target = dof.focus_object
+    if target is None:
+        return float(dof.focus_distance)
+    target = target.evaluated_get(depsgraph)
+    m = np.array(target.matrix_world, np.float64)
+    if dof.focus_subtarget and target.pose is not None:
+        bone = target.pose.bones.get(dof.focus_subtarget)
+        if bone is not None:
+            m = m @ np.array(bone.matrix, np.float64)
+    cam = np.array(ob.matrix_world, np.float64)
+    view_axis = cam[:3, 2] / np.linalg.norm(cam[:3, 2])
+    return abs(float(np.dot(view_axis, cam[:3, 3] - m[:3, 3])))
 
 
 def camera_from_view(view_matrix, window_matrix, unit_scale: float = 1.0) -> Camera:

@@ -15,6 +15,14 @@ The camera looks along its local -Z with +Y up.  The view plane at distance 1
 Raster coordinates: x to the right, y downwards, (0, 0) the top-left corner of
 the full frame; pixel (i, j) covers [i, i+1) x [j, j+1).
 
+Depth of field follows kernel/camera/camera.h: a point on the aperture (a
+disk, or a polygon of blades, squeezed by the anamorphic ratio, times the
+aperture radius) becomes the ray's origin in the lens plane, and the ray aims
+at the point where the pinhole ray meets the plane of focus (perspective), or
+converges on the pinhole ray's point at the focal distance (orthographic).
+Clipping keeps Cycles' arithmetic: the near-clip offset and the far limit are
+those of the pinhole ray, applied along the lens ray.
+
 ``generate_camera_rays`` starts the paths of a chunk: a raster position per
 sample from the pixel filter, its camera ray, and a fresh path state.
 """
@@ -26,7 +34,17 @@ import numpy as np
 
 from ..jit import device, kernel
 from .intersect import T_INFINITE
-from .sampling import DIM_FILTER_X, DIM_FILTER_Y, filter_offset, path_key, rand
+from .sampling import (
+    DIM_FILTER_X,
+    DIM_FILTER_Y,
+    DIM_LENS_U,
+    DIM_LENS_V,
+    disk_concentric,
+    filter_offset,
+    path_key,
+    rand,
+    regular_polygon,
+)
 from .state import (
     CFG_FULL_W,
     CFG_REGION_W,
@@ -55,7 +73,12 @@ C_CLIP_START = 17
 C_CLIP_END = 18
 C_WIDTH = 19         # full frame in pixels
 C_HEIGHT = 20
-CAMERA_PARAMS = 21
+C_APERTURE = 21      # aperture radius (0: pinhole camera, no lens sample is drawn)
+C_FOCUS = 22         # focal distance along the view axis
+C_BLADES = 23        # polygon corners (0: a disk)
+C_BLADES_ROTATION = 24
+C_INV_RATIO = 25     # 1 / anamorphic aperture ratio, applied to the lens x
+CAMERA_PARAMS = 26
 
 
 def view_plane(cam, width: int, height: int, pixel_aspect=(1.0, 1.0)):
@@ -107,18 +130,28 @@ def pack_camera(cam, film) -> np.ndarray:
     p[C_SHIFT_X], p[C_SHIFT_Y] = sx, sy
     p[C_CLIP_START], p[C_CLIP_END] = cam.clip_start, cam.clip_end
     p[C_WIDTH], p[C_HEIGHT] = film.width, film.height
+    p[C_APERTURE] = cam.aperture_size
+    p[C_FOCUS] = cam.focal_distance
+    # Cycles samples a disk below three blades.
+    p[C_BLADES] = cam.aperture_blades if cam.aperture_blades >= 3 else 0
+    p[C_BLADES_ROTATION] = cam.aperture_rotation
+    p[C_INV_RATIO] = 1.0 / cam.aperture_ratio
     return p
 
 
 @device
-def camera_ray(cam, rx, ry):
+def camera_ray(cam, rx, ry, lens_u, lens_v):
     """World-space ray through raster position (rx, ry).
 
-    Returns ``(ox, oy, oz, dx, dy, dz, tmax)`` with a unit direction; the
-    origin lies on the near clip plane and ``tmax`` reaches the far plane.
+    ``lens_u``, ``lens_v`` in [0, 1) pick the point on the aperture (unused by
+    a pinhole camera).  Returns ``(ox, oy, oz, dx, dy, dz, tmax)`` with a unit
+    direction; the origin lies on the near clip plane and ``tmax`` reaches the
+    far plane.
     """
     x = cam[C_SHIFT_X] + (2.0 * rx / cam[C_WIDTH] - 1.0) * cam[C_HALF_W]
     y = cam[C_SHIFT_Y] + (1.0 - 2.0 * ry / cam[C_HEIGHT]) * cam[C_HALF_H]
+    if cam[C_APERTURE] > 0.0:
+        return lens_ray(cam, x, y, lens_u, lens_v)
     if cam[C_TYPE] == CAM_ORTHO:
         ox = cam[C_POS] + x * cam[C_RIGHT] + y * cam[C_UP] + cam[C_CLIP_START] * cam[C_FWD]
         oy = cam[C_POS + 1] + x * cam[C_RIGHT + 1] + y * cam[C_UP + 1] + cam[C_CLIP_START] * cam[C_FWD + 1]
@@ -138,6 +171,58 @@ def camera_ray(cam, rx, ry):
             dx, dy, dz, (cam[C_CLIP_END] - cam[C_CLIP_START]) / inv_len)
 
 
+@device
+def aperture_point(cam, u1, u2):
+    """Point on the lens in camera coordinates (x right, y up), Cycles' camera_sample_aperture.
+
+    A uniform point on the unit disk (concentric map) or on the regular
+    polygon of the blades, x divided by the anamorphic ratio, times the
+    aperture radius.
+    """
+    if cam[C_BLADES] == 0.0:
+        bx, by = disk_concentric(u1, u2)
+    else:
+        bx, by = regular_polygon(cam[C_BLADES], cam[C_BLADES_ROTATION], u1, u2)
+    r = cam[C_APERTURE]
+    return bx * cam[C_INV_RATIO] * r, by * r
+
+
+@device
+def lens_ray(cam, x, y, u1, u2):
+    """The ray of a thin lens through view-plane point (x, y), as :func:`camera_ray` returns it."""
+    lx, ly = aperture_point(cam, u1, u2)
+    focus = cam[C_FOCUS]
+    near = cam[C_CLIP_START]
+    # Camera space: x right, y up, z along the view axis.
+    if cam[C_TYPE] == CAM_ORTHO:
+        # Aim from the lens point at (0, 0, focus); start where that ray
+        # crosses the near plane, offset by the pinhole ray's position.
+        cx, cy, cz = -lx, -ly, focus
+        inv = 1.0 / math.sqrt(cx * cx + cy * cy + cz * cz)
+        cx, cy, cz = cx * inv, cy * inv, cz * inv
+        s = near / cz
+        px, py, pz = x + lx + cx * s, y + ly + cy * s, cz * s
+        tmax = cam[C_CLIP_END] - near
+    else:
+        # Aim from the lens point at the pinhole ray's point on the plane of focus.
+        cx, cy, cz = x * focus - lx, y * focus - ly, focus
+        inv = 1.0 / math.sqrt(cx * cx + cy * cy + cz * cz)
+        cx, cy, cz = cx * inv, cy * inv, cz * inv
+        # Cycles clips along the lens ray with the pinhole ray's 1/cos.
+        z_inv = math.sqrt(x * x + y * y + 1.0)
+        t0 = near * z_inv
+        px, py, pz = lx + t0 * cx, ly + t0 * cy, t0 * cz
+        tmax = (cam[C_CLIP_END] - near) * z_inv
+    ox = cam[C_POS] + px * cam[C_RIGHT] + py * cam[C_UP] + pz * cam[C_FWD]
+    oy = cam[C_POS + 1] + px * cam[C_RIGHT + 1] + py * cam[C_UP + 1] + pz * cam[C_FWD + 1]
+    oz = cam[C_POS + 2] + px * cam[C_RIGHT + 2] + py * cam[C_UP + 2] + pz * cam[C_FWD + 2]
+    dx = cx * cam[C_RIGHT] + cy * cam[C_UP] + cz * cam[C_FWD]
+    dy = cx * cam[C_RIGHT + 1] + cy * cam[C_UP + 1] + cz * cam[C_FWD + 1]
+    dz = cx * cam[C_RIGHT + 2] + cy * cam[C_UP + 2] + cz * cam[C_FWD + 2]
+    inv = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+    return ox, oy, oz, dx * inv, dy * inv, dz * inv, tmax
+
+
 @kernel
 def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     """Start ``spp`` paths for each film pixel in ``pixels``; returns the path count.
@@ -148,6 +233,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     """
     n = 0
     region_x, region_y, region_w = cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W]
+    lens = sc.camera[C_APERTURE] > 0.0
     for pi in range(pixels.shape[0]):
         pix = pixels[pi]
         x = region_x + pix % region_w
@@ -162,7 +248,11 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             else:
                 fx = filter_offset(sc.filter_table, rand(key, DIM_FILTER_X))
                 fy = filter_offset(sc.filter_table, rand(key, DIM_FILTER_Y))
-            ox, oy, oz, dx, dy, dz, tmax = camera_ray(sc.camera, x + fx, y + fy)
+            lu = lv = 0.0
+            if lens:
+                lu = rand(key, DIM_LENS_U)
+                lv = rand(key, DIM_LENS_V)
+            ox, oy, oz, dx, dy, dz, tmax = camera_ray(sc.camera, x + fx, y + fy, lu, lv)
             st.key[n] = key
             st.pixel[n] = pix
             st.ray_o[n, 0], st.ray_o[n, 1], st.ray_o[n, 2] = ox, oy, oz
@@ -187,9 +277,12 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
     return n
 
 
-
-def camera_rays(scene_camera, film, rx, ry):
-    """Vectorised helper (tests, tools): rays for arrays of raster positions."""
+def camera_rays(scene_camera, film, rx, ry, lens_u=None, lens_v=None):
+    """Vectorised helper (tests, tools): rays for arrays of raster positions (and lens samples)."""
     p = pack_camera(scene_camera, film)
-    out = np.array([camera_ray(p, float(a), float(b)) for a, b in zip(np.ravel(rx), np.ravel(ry))])
+    rx, ry = np.ravel(rx), np.ravel(ry)
+    lu = np.zeros(rx.size) if lens_u is None else np.ravel(lens_u)
+    lv = np.zeros(rx.size) if lens_v is None else np.ravel(lens_v)
+    out = np.array([camera_ray(p, float(a), float(b), float(u), float(v))
+                    for a, b, u, v in zip(rx, ry, lu, lv)])
     return out[:, :3], out[:, 3:6], out[:, 6]

@@ -101,6 +101,29 @@ def disk_polar(u1, u2):
 
 
 @device
+def regular_polygon(corners, rotation, u1, u2):
+    """Uniform point in the regular polygon with ``corners`` vertices on the unit circle.
+
+    Cycles' aperture-blade sampler (kernel/sample/mapping.h): ``u1`` picks one
+    of the polygon's triangles (the centre and one edge) and is reused, with
+    ``u2``, as a uniform point in that triangle; the polygon is turned by
+    ``rotation`` (its first vertex lies at angle ``rotation + pi/corners``).
+    """
+    corner = math.floor(u1 * corners)
+    u = u1 * corners - corner
+    u = math.sqrt(u)              # uniform barycentrics in the triangle
+    v = u2 * u
+    u = 1.0 - u
+    angle = math.pi / corners
+    px = (u + v) * math.cos(angle)
+    py = (u - v) * math.sin(angle)
+    rotation += corner * 2.0 * angle
+    cr = math.cos(rotation)
+    sr = math.sin(rotation)
+    return cr * px - sr * py, sr * px + cr * py
+
+
+@device
 def cosine_hemisphere(u1, u2):
     """Direction around +z with density cos(theta)/pi (Malley's method)."""
     x, y = disk_concentric(u1, u2)

@@ -73,8 +73,35 @@ def test_panoramic_camera_is_an_export_error(scene, addon):
         addon.export.export(depsgraph)
 
 
-def test_depth_of_field_is_warned(scene, fake_session):
-    scene.camera.data.dof.use_dof = True
-    desc = export_scene(fake_session)
-    assert "camera 'Camera': depth of field not supported yet; rendered as a pinhole camera" \
-        in desc.warnings
+def test_depth_of_field_as_cycles_derives_it(scene, fake_session):
+    dof = scene.camera.data.dof
+    dof.use_dof, dof.aperture_fstop, dof.focus_distance = True, 2.0, 7.5
+    dof.aperture_blades, dof.aperture_rotation, dof.aperture_ratio = 6, 0.3, 1.5
+    scene.camera.data.lens = 40.0
+    c = export_scene(fake_session).camera
+    assert c.aperture_size == pytest.approx(0.040 / (2 * 2.0))     # lens / (2 f-stop), metres
+    assert c.focal_distance == pytest.approx(7.5)
+    assert (c.aperture_blades, c.aperture_ratio) == (6, pytest.approx(1.5))
+    assert c.aperture_rotation == pytest.approx(0.3)
+    assert not any("depth of field" in w for w in export_scene(fake_session).warnings)
+    dof.aperture_fstop = 0.0                          # Cycles clamps the f-stop to 1e-5
+    assert export_scene(fake_session).camera.aperture_size == pytest.approx(0.040 / 2e-5)
+    dof.use_dof = False
+    c = export_scene(fake_session).camera
+    assert (c.aperture_size, c.aperture_ratio) == (0.0, 1.0)
+
+
+def test_depth_of_field_focus_object_and_units(scene, fake_session):
+    scene.unit_settings.scale_length = 0.5
+    cam = scene.camera
+    cam.location, cam.rotation_euler = (0, -10, 0), (math.pi / 2, 0, 0)    # looking along +Y
+    target = bpy.data.objects.new("Target", None)
+    scene.collection.objects.link(target)
+    target.location = (3.0, -4.0, 2.0)                # 6 units ahead, off the axis
+    cam.data.dof.use_dof, cam.data.dof.focus_object = True, target
+    cam.data.dof.aperture_fstop = 4.0
+    cam.data.type, cam.data.ortho_scale = "ORTHO", 8.0
+    bpy.context.view_layer.update()
+    c = export_scene(fake_session).camera
+    assert c.focal_distance == pytest.approx(6.0 * 0.5)           # depth along the view axis
+    assert c.aperture_size == pytest.approx(1.0 / (2 * 4.0) * 0.5)  # orthographic: 1 / (2 f-stop)

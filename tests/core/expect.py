@@ -43,3 +43,19 @@ def assert_mean(session, expected, *, channel=0, max_rel_se=0.002, deterministic
     assert abs(mean - expected) <= tol, (
         f"mean {mean:.6g} vs expected {expected:.6g} (se {se:.3g}, z {(mean - expected) / max(se, 1e-300):.2f})")
     return mean, se
+
+
+def chi2_uniform_disk(points, rings=10, sectors=12):
+    """Pearson chi-square of 2-D points against the uniform density on the unit disk.
+
+    Cells are equal-area: rings of equal r^2 width times equal sectors.
+    Returns ``(statistic, degrees of freedom)``.
+    """
+    points = np.asarray(points, float)
+    r = np.hypot(points[:, 0], points[:, 1])
+    ring = np.minimum((r * r * rings).astype(int), rings - 1)
+    angle = np.arctan2(points[:, 1], points[:, 0]) + np.pi
+    sector = (angle / (2 * np.pi) * sectors).astype(int) % sectors
+    counts = np.bincount(ring * sectors + sector, minlength=rings * sectors)
+    expected = len(points) / (rings * sectors)
+    return ((counts - expected) ** 2 / expected).sum(), rings * sectors - 1

@@ -8,7 +8,7 @@ from mcengine.imageio import ImageError, read_exr, write_exr, write_png
 from mcengine.kernels.sampling import disk_concentric, disk_polar, filter_offset, filter_table
 from mcengine.scene import SceneDescription, SceneError
 
-from .expect import render
+from .expect import chi2_uniform_disk, render
 from .scenes import inside_sphere_scene
 
 
@@ -53,16 +53,6 @@ def test_exr_round_trip_and_png(tmp_path):
         write_exr(tmp_path / "missing" / "a.exr", img)
 
 
-def _chi2_uniform_disk(points, rings=10, sectors=12):
-    """Pearson chi-square of points in equal-area cells of the unit disk."""
-    r = np.hypot(points[:, 0], points[:, 1])
-    ring = np.minimum((r * r * rings).astype(int), rings - 1)      # equal-area rings
-    sector = ((np.arctan2(points[:, 1], points[:, 0]) + math.pi) / (2 * math.pi) * sectors).astype(int) % sectors
-    counts = np.bincount(ring * sectors + sector, minlength=rings * sectors)
-    expected = len(points) / (rings * sectors)
-    return ((counts - expected) ** 2 / expected).sum(), rings * sectors - 1
-
-
 def test_disk_sampling_is_uniform_and_the_naive_map_is_not():
     """The lecture's example: r = sqrt(u) is uniform on the disk, r = u crowds the centre."""
     from scipy.stats import chi2
@@ -71,10 +61,10 @@ def test_disk_sampling_is_uniform_and_the_naive_map_is_not():
         return chi2.ppf(1 - 1e-4, dof)
     for warp in (disk_polar, disk_concentric):
         pts = np.array([warp(a, b) for a, b in u])
-        stat, dof = _chi2_uniform_disk(pts)
+        stat, dof = chi2_uniform_disk(pts)
         assert stat < crit(dof), (warp.__name__, stat)
     naive = np.stack([u[:, 0] * np.cos(2 * math.pi * u[:, 1]), u[:, 0] * np.sin(2 * math.pi * u[:, 1])], 1)
-    stat, dof = _chi2_uniform_disk(naive)
+    stat, dof = chi2_uniform_disk(naive)
     assert stat > 100 * crit(dof)
 
 

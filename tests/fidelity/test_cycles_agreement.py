@@ -39,7 +39,7 @@ def test_scenes_exist():
             # added for the fidelity suite: every light parameter, transforms, cameras
             "light_area_spread", "light_point_large", "light_spot_shapes", "light_sun_wide",
             "transforms", "instancing_modifiers", "camera_sensor_fit", "camera_portrait_wide",
-            "camera_ortho"} <= names
+            "camera_ortho", "camera_dof", "camera_dof_ortho"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

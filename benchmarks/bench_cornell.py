@@ -1,36 +1,54 @@
-"""Paths per second of MC Engine and Cycles on the Cornell box, head to head.
+"""Paths per second of MC Engine, Cycles and Mitsuba 3 on the Cornell box, head to head.
 
-Both engines render blend_scenes/cornell_box.blend through
+MC Engine and Cycles render blend_scenes/cornell_box.blend through
 ``bpy.ops.render.render`` in this process, with the file's bounces (8), no
-clamping, no denoising, no adaptive sampling, the same resolution and samples,
-alternating engine by engine for several rounds (this machine's speed drifts,
-so only same-run ratios mean something).  A "path" is one camera sample.
+clamping, no denoising, no adaptive sampling, the same resolution and samples.
+Mitsuba 3 (``llvm_ad_rgb``, in a child process: see mitsuba_peer.py) renders the
+scene MC Engine exported, so geometry, materials, light, camera and resolution
+are the same.  Engines alternate render by render for several rounds (this
+machine's speed drifts, so only same-run ratios mean something).  A "path" is
+one camera sample.
 
 Two figures per engine:
 
 * wall: pixels x samples / wall time of the whole render call (export, BVH,
-  kernel loading and Cycles' scene sync included);
+  kernel loading and Cycles' scene sync included; for Mitsuba the render call
+  on the loaded scene);
 * marginal: the extra paths of a full render over a 1-sample render, divided by
-  the extra time, which removes each engine's fixed start-up cost.
+  the extra time, which removes each engine's fixed start-up cost.  Mitsuba's
+  JIT compile is excluded: warm-up renders at both sample counts compile its
+  kernels before the rounds, and what drjit's kernel history still counts as
+  code generation in a timed render is subtracted.
 
-For MC Engine it also prints the share of worker time spent inside Embree,
-rays per path, and the peak resident memory of the process (Blender included)
-and of the renderer's own buffers.
+It also prints rays per path (MC Engine's counters; Mitsuba's by replaying its
+stopping rules, as its Russian roulette differs), for MC Engine the share of
+worker time spent inside Embree and the peak resident memory of the process
+(Blender included) and of the renderer's own buffers, and each engine's frame
+mean, as a check that all rendered the same scene.
 
 With ``--materials principled`` every surface is the default Principled BSDF
 (roughness 0.5, Specular IOR Level 0.5, Multiscatter GGX) of its base colour,
-the material a Blender user starts from.
+the material a Blender user starts from (Mitsuba's ``principled`` plugin is
+only approximately the same BSDF).
+
+Mitsuba comes from the optional ``bench`` extra (``pip install -e '.[bench]'``);
+drjit needs a libLLVM >= 16, found on its own or named by DRJIT_LIBLLVM_PATH.
 
 Run: python benchmarks/bench_cornell.py [--samples N] [--resolution N] [--rounds R]
-                                        [--materials file|principled]
+                                        [--materials file|principled] [--no-mitsuba]
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import resource
 import statistics
 import sys
+import tempfile
 from pathlib import Path
+
+import mitsuba_peer
+import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "blend_scenes" / "cornell_box.blend"
@@ -44,7 +62,16 @@ def main(argv=None) -> int:
     ap.add_argument("--materials", choices=("file", "principled"), default="file",
                     help="the file's Lambert materials, or every surface the default Principled "
                          "BSDF of the same base colour (the light keeps its emission)")
+    ap.add_argument("--no-mitsuba", action="store_true",
+                    help="leave Mitsuba 3 out (it needs the 'bench' extra: pip install -e '.[bench]')")
     args = ap.parse_args(argv)
+    if not args.no_mitsuba:
+        try:
+            import mitsuba  # noqa: F401
+        except ImportError:
+            print("bench_cornell: Mitsuba 3 is not installed: pip install -e '.[bench]' "
+                  "(or pass --no-mitsuba)", file=sys.stderr)
+            return 2
 
     import bpy  # noqa: F401  (Blender as a module)
 
@@ -53,12 +80,13 @@ def main(argv=None) -> int:
     from mcengine_blender.batch.settings import make_unbiased
 
     ensure_registered()
-    sessions = []
+    sessions, scenes = [], []
     real_factory = engine.session_factory
 
     def recording_factory(desc, threads=None):
         s = real_factory(desc, threads=threads)
         sessions.append(s)
+        scenes.append(desc)
         return s
 
     engine.session_factory = recording_factory
@@ -75,20 +103,42 @@ def main(argv=None) -> int:
     # Warm-up: load numba's kernel cache and Cycles' kernels once.
     run("mcengine", 1)
     run("cycles", 1)
-    figures = {"MCENGINE": {"wall": [], "marginal": []}, "CYCLES": {"wall": [], "marginal": []}}
-    our_stats = []
-    for r in range(args.rounds):
-        order = ("cycles", "mcengine") if r % 2 == 0 else ("mcengine", "cycles")
-        for name in order:
-            one = run(name, 1)
-            full = run(name, args.samples)
-            f = figures[full.engine]
-            f["wall"].append(pixels * args.samples / full.seconds)
-            f["marginal"].append(pixels * (args.samples - 1) / max(full.seconds - one.seconds, 1e-9))
-            if full.engine == "MCENGINE":
-                our_stats.append(sessions[-1].stats)
-            print(f"round {r + 1}: {full.engine:9s} {args.samples} spp {full.seconds:6.2f} s "
-                  f"(1 spp {one.seconds:5.2f} s)", flush=True)
+    with contextlib.ExitStack() as stack:
+        peer = None
+        if not args.no_mitsuba:
+            folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bench_mitsuba_")))
+            try:
+                spec, notes = mitsuba_peer.scene_spec(scenes[-1], folder)
+                peer = stack.enter_context(mitsuba_peer.MitsubaPeer(spec, folder))
+            except mitsuba_peer.PeerError as exc:
+                print(f"bench_cornell: {exc}", file=sys.stderr)
+                return 2
+            warm = [peer.render(1, 0), peer.render(args.samples, 0)]
+        engines = ["CYCLES", "MCENGINE"] + (["MITSUBA"] if peer else [])
+        figures = {e: {"wall": [], "marginal": []} for e in engines}
+        images, our_stats = {}, []
+        for r in range(args.rounds):
+            order = engines[r % len(engines):] + engines[:r % len(engines)]
+            for name in order:
+                if name == "MITSUBA":
+                    save = folder / "mitsuba.npy"
+                    one, full = peer.render(1, r + 1), peer.render(args.samples, r + 1, save)
+                    # The kernels were compiled by the warm-up renders; what drjit still spends
+                    # on tracing and code generation in a timed render is taken out.
+                    t_one, t_full = (one["seconds"] - one["compile"], full["seconds"] - full["compile"])
+                    images[name] = np.load(save)
+                else:
+                    one, full = run(name.lower(), 1), run(name.lower(), args.samples)
+                    t_one, t_full = one.seconds, full.seconds
+                    images[name] = full.image[..., :3]
+                    if name == "MCENGINE":
+                        our_stats.append(sessions[-1].stats)
+                f = figures[name]
+                f["wall"].append(pixels * args.samples / t_full)
+                f["marginal"].append(pixels * (args.samples - 1) / max(t_full - t_one, 1e-9))
+                print(f"round {r + 1}: {name:9s} {args.samples} spp {t_full:6.2f} s "
+                      f"(1 spp {t_one:5.2f} s)", flush=True)
+        mitsuba_rays = peer.rays_per_path() if peer else None
 
     med = {e: {k: statistics.median(v) for k, v in f.items()} for e, f in figures.items()}
     st = our_stats[-1]
@@ -97,18 +147,57 @@ def main(argv=None) -> int:
     print()
     print(f"Cornell box ({args.materials} materials) {args.resolution}x{args.resolution}, "
           f"{args.samples} spp, 8 bounces, medians of {args.rounds} rounds")
-    print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}")
-    for e in ("MCENGINE", "CYCLES"):
-        print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}")
-    print(f"{'ratio':12s}{med['MCENGINE']['wall'] / med['CYCLES']['wall']:15.2f}"
-          f"{med['MCENGINE']['marginal'] / med['CYCLES']['marginal']:20.2f}")
+    print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}{'rays/path':>12s}"
+          f"  (Cycles: the same paths as MC Engine)")
+    # Cycles traces the same light paths as MC Engine (same rules); its rays are not counted.
+    rays = {"MCENGINE": st.rays / st.paths, "CYCLES": st.rays / st.paths, "MITSUBA": mitsuba_rays}
+    for e in engines:
+        print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}{rays[e]:12.2f}")
+    for other in engines[:1] + engines[2:]:
+        print(f"{'MC / ' + other.lower():12s}{med['MCENGINE']['wall'] / med[other]['wall']:15.2f}"
+              f"{med['MCENGINE']['marginal'] / med[other]['marginal']:20.2f}")
     print(f"MC Engine: {st.rays / st.paths:.2f} rays/path, {st.rays_per_second / 1e6:.1f} Mrays/s, "
           f"Embree {100 * st.embree_share:.0f} % of worker time, kernels loaded in "
           f"{sessions[0].stats.time_kernels:.2f} s (first render of the process), "
           f"BVH {st.time_bvh * 1e3:.0f} ms")
     print(f"memory: renderer buffers {buffers / 2**20:.0f} MiB; process peak RSS "
           f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB (Blender included)")
+    if peer:
+        print(f"Mitsuba 3 {mitsuba_peer.VARIANT} (libLLVM {peer.libllvm}): scene loaded in "
+              f"{peer.load_seconds:.2f} s; its wall time is the render call alone. JIT compile "
+              f"excluded: warm-up renders at 1 and {args.samples} spp ({warm[0]['seconds']:.2f} s "
+              f"and {warm[1]['seconds']:.2f} s) compiled both kernels (code generation and LLVM "
+              f"{warm[0]['compile'] + warm[1]['compile']:.2f} s by drjit's kernel history; kernels "
+              f"in drjit's disk cache load without compiling), and each timed render's own code "
+              f"generation (tracing, milliseconds) is subtracted")
+        print("Mitsuba: rays/path counted by replaying its path integrator's stopping rules "
+              "(Russian roulette from depth 3 with survival min(throughput, 0.95); Cycles and "
+              "MC Engine use min(sqrt(throughput), 1), so their paths are longer)")
+        for note in notes:
+            print(f"Mitsuba: {note}")
+    print_agreement(images)
     return 0
+
+
+def print_agreement(images: dict) -> None:
+    """Frame means and the largest difference of 4x4 block means, against MC Engine's image:
+    a check that every engine rendered the same scene (not a statistical test)."""
+    ours = images["MCENGINE"]
+    h, w = ours.shape[:2]
+
+    def blocks(im):
+        return im[:h // 4 * 4, :w // 4 * 4].reshape(4, h // 4, 4, w // 4, 3).mean(axis=(1, 3))
+
+    print("image check (same scene?): frame mean RGB, and vs MC Engine the frame mean's "
+          "difference and the largest 4x4-block difference")
+    for name, im in images.items():
+        mean = im.reshape(-1, 3).mean(axis=0)
+        line = f"  {name:9s} mean ({mean[0]:.4f}, {mean[1]:.4f}, {mean[2]:.4f})"
+        if name != "MCENGINE":
+            rel = mean.sum() / ours.reshape(-1, 3).mean(axis=0).sum() - 1.0
+            block = np.abs(blocks(im) - blocks(ours)).max() / blocks(ours).mean()
+            line += f"  frame {100 * rel:+.1f} %, worst block {100 * block:.1f} % of the mean"
+        print(line)
 
 
 def to_default_principled(bpy) -> None:

@@ -1,0 +1,87 @@
+"""The scene of the scale benchmark: a bumpy ground of N triangles in a three-walled room.
+
+A smooth-shaded height field (a grid of quads, each split into two triangles by
+Blender) of 4 x 4 m fills the floor of an open room with a back wall and two side
+walls, lit by a 1 m square area light and the 0.05 grey world, seen from the open
+side, with 8 bounces and the unbiased settings of blend_scenes/_common.py.  Almost
+every triangle is the ground, so the triangle count is what grows; the walls keep
+paths bouncing as in the Cornell box.
+
+The mesh is built with ``foreach_set`` from numpy arrays (``from_pydata`` takes
+minutes for millions of faces) and saved to a temporary .blend, which is not kept.
+
+Run on its own: python benchmarks/scale_scene.py TRIANGLES OUT.blend
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+GROUND_SIZE = 4.0       # metres
+BUMP_HEIGHT = 0.15      # metres, amplitude of the height field
+BUMP_WAVES = 6.0        # bumps across the ground
+
+
+def grid_side(triangles: int) -> int:
+    """Quads per side of the grid whose 2 n^2 triangles come closest to ``triangles``."""
+    return max(1, round(math.sqrt(triangles / 2.0)))
+
+
+def build(triangles: int, path: Path) -> int:
+    """Write the scene with about ``triangles`` ground triangles to ``path``; returns the
+    total triangle count (ground and walls)."""
+    sys.path.insert(0, str(REPO / "blend_scenes"))
+    import _common as c
+    import bpy
+
+    scene = c.new_scene()
+    c.set_bounces(scene, total=8, diffuse=8, glossy=8, transmission=8)
+    c.set_world(scene, (0.05, 0.05, 0.05))
+    white = c.diffuse_material("White", (0.73, 0.73, 0.73))
+    red = c.diffuse_material("Red", (0.63, 0.065, 0.05))
+    green = c.diffuse_material("Green", (0.14, 0.45, 0.09))
+    n = grid_side(triangles)
+    ground = _height_field(bpy, n)
+    ground.materials.append(white)
+    scene.collection.objects.link(bpy.data.objects.new("Ground", ground))
+    h = GROUND_SIZE / 2
+    c.add_quad(scene, "BackWall", [(-h, h, 0), (h, h, 0), (h, h, 2), (-h, h, 2)], white)
+    c.add_quad(scene, "LeftWall", [(-h, -h, 0), (-h, h, 0), (-h, h, 2), (-h, -h, 2)], red)
+    c.add_quad(scene, "RightWall", [(h, -h, 0), (h, -h, 2), (h, h, 2), (h, h, 0)], green)
+    c.add_light(scene, "AreaLight", "AREA", 200.0, (0.0, 0.0, 3.0), shape="SQUARE", size=1.0)
+    c.add_camera(scene, (0.0, -6.5, 3.0), (0.0, 0.0, 0.3), lens_mm=35.0)
+    bpy.context.view_layer.update()
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=False, copy=True)
+    return 2 * n * n + 6
+
+
+def _height_field(bpy, n: int):
+    """An n x n grid of smooth-shaded quads over GROUND_SIZE, displaced by a sum of sines."""
+    side = np.linspace(-GROUND_SIZE / 2, GROUND_SIZE / 2, n + 1)
+    x, y = np.meshgrid(side, side, indexing="xy")
+    k = 2.0 * math.pi * BUMP_WAVES / GROUND_SIZE
+    z = BUMP_HEIGHT * (1.0 + np.sin(k * x) * np.cos(k * y))
+    co = np.stack([x, y, z], axis=-1).reshape(-1, 3).astype(np.float32)
+    i = np.arange(n)
+    a = (i[None, :] + (n + 1) * i[:, None]).reshape(-1)       # lower-left corner of each quad
+    corners = np.stack([a, a + 1, a + n + 2, a + n + 1], axis=1).astype(np.int32)
+    me = bpy.data.meshes.new("Ground")
+    me.vertices.add(len(co))
+    me.vertices.foreach_set("co", co.reshape(-1))
+    me.loops.add(corners.size)
+    me.loops.foreach_set("vertex_index", corners.reshape(-1))
+    me.polygons.add(len(corners))
+    me.polygons.foreach_set("loop_start", np.arange(0, corners.size, 4, dtype=np.int32))
+    me.update(calc_edges=True)
+    me.shade_smooth()
+    return me
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit(__doc__.strip().splitlines()[-1])
+    print(build(int(sys.argv[1]), Path(sys.argv[2])))

@@ -148,14 +148,16 @@ def main(argv=None) -> int:
     print(f"Cornell box ({args.materials} materials) {args.resolution}x{args.resolution}, "
           f"{args.samples} spp, 8 bounces, medians of {args.rounds} rounds")
     print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}{'rays/path':>12s}"
-          f"  (Cycles: the same paths as MC Engine)")
+          f"{'marginal Mrays/s':>18s}  (Cycles: the same paths as MC Engine)")
     # Cycles traces the same light paths as MC Engine (same rules); its rays are not counted.
     rays = {"MCENGINE": st.rays / st.paths, "CYCLES": st.rays / st.paths, "MITSUBA": mitsuba_rays}
     for e in engines:
-        print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}{rays[e]:12.2f}")
+        print(f"{e:12s}{med[e]['wall'] / 1e6:15.2f}{med[e]['marginal'] / 1e6:20.2f}{rays[e]:12.2f}"
+              f"{med[e]['marginal'] * rays[e] / 1e6:18.2f}")
     for other in engines[:1] + engines[2:]:
         print(f"{'MC / ' + other.lower():12s}{med['MCENGINE']['wall'] / med[other]['wall']:15.2f}"
-              f"{med['MCENGINE']['marginal'] / med[other]['marginal']:20.2f}")
+              f"{med['MCENGINE']['marginal'] / med[other]['marginal']:20.2f}{'':12s}"
+              f"{med['MCENGINE']['marginal'] * rays['MCENGINE'] / (med[other]['marginal'] * rays[other]):18.2f}")
     print(f"MC Engine: {st.rays / st.paths:.2f} rays/path, {st.rays_per_second / 1e6:.1f} Mrays/s, "
           f"Embree {100 * st.embree_share:.0f} % of worker time, kernels loaded in "
           f"{sessions[0].stats.time_kernels:.2f} s (first render of the process), "

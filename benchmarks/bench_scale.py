@@ -29,8 +29,9 @@ peak resident memory.  Figures:
 
 Writes ``scale.csv`` and ``scale.png`` (matplotlib) into ``--out`` (default
 out/bench_scale/) and prints a Markdown table.  A default run takes about 10
-minutes on 2 cores; ``--full`` adds the 4M-triangle scene and 4K at 1M and 4M
-triangles (about 20 minutes more).
+minutes on 2 cores; ``--full`` adds the 4M-triangle scene, 4K at 1M and 4M
+triangles, and 4K at 100k triangles with 8 samples, to show that memory does not
+grow with samples (about 30 minutes more).
 
 Run: python benchmarks/bench_scale.py [--full] [--engines mcengine,cycles]
                                       [--resolution N] [--paths N] [--out DIR]
@@ -55,6 +56,7 @@ TRIANGLES = (1_000, 10_000, 100_000, 1_000_000)
 FULL_TRIANGLES = (4_000_000,)
 RESOLUTIONS = ((256, 256), (1024, 1024), (1920, 1080), (3840, 2160))
 RESOLUTION_SWEEP_TRIANGLES = 100_000
+FULL_4K_SAMPLES = 8
 FIELDS = ("engine", "triangles", "width", "height", "samples", "first_image_s", "export_s",
           "prepare_s", "bvh_s", "kernels_s", "sync_s", "startup_rest_s", "render_1spp_s",
           "render_s", "mpaths_per_s", "rss_scene_mib", "rss_peak_mib", "render_own_mib",
@@ -79,15 +81,17 @@ def main(argv=None) -> int:
         return 2
 
     tri_sweep = TRIANGLES + (FULL_TRIANGLES if args.full else ())
-    runs = [(t, (args.resolution, args.resolution)) for t in tri_sweep]
-    runs += [(RESOLUTION_SWEEP_TRIANGLES, r) for r in RESOLUTIONS
-             if (RESOLUTION_SWEEP_TRIANGLES, r) not in runs]
+    runs = [(t, (args.resolution, args.resolution), None) for t in tri_sweep]
+    runs += [(RESOLUTION_SWEEP_TRIANGLES, r, None) for r in RESOLUTIONS
+             if (RESOLUTION_SWEEP_TRIANGLES, r, None) not in runs]
     if args.full:
-        runs += [(t, RESOLUTIONS[-1]) for t in (1_000_000, 4_000_000)]
+        # 4K with the big scenes, and with 4x the samples (memory must not grow with them).
+        runs += [(t, RESOLUTIONS[-1], None) for t in (1_000_000, 4_000_000)]
+        runs += [(RESOLUTION_SWEEP_TRIANGLES, RESOLUTIONS[-1], FULL_4K_SAMPLES)]
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench_scale_") as tmp:
         blends = {}
-        for triangles in sorted({t for t, _r in runs}):
+        for triangles in sorted({t for t, _r, _s in runs}):
             path = Path(tmp) / f"scale_{triangles}.blend"
             t0 = time.perf_counter()
             done = subprocess.run([sys.executable, str(Path(__file__).with_name("scale_scene.py")),
@@ -99,9 +103,9 @@ def main(argv=None) -> int:
             blends[triangles] = (path, int(done.stdout.split()[-1]))
             print(f"scene of {blends[triangles][1]:,} triangles built in "
                   f"{time.perf_counter() - t0:.1f} s", flush=True)
-        for triangles, (w, h) in runs:
+        for triangles, (w, h), samples in runs:
             path, count = blends[triangles]
-            samples = max(2, math.ceil(args.paths / (w * h)))
+            samples = samples or max(2, math.ceil(args.paths / (w * h)))
             for engine in engines:
                 row = measure(engine, path, w, h, samples)
                 row["triangles"] = count
@@ -242,15 +246,22 @@ def write_csv(rows, path: Path) -> None:
 
 
 def markdown_table(rows) -> str:
-    head = ("| engine | triangles | resolution | spp | first image (s) | export or sync (s) | BVH (s) "
-            "| Mpaths/s | peak RSS (MiB) | render's own (MiB) |")
-    lines = [head, "|" + " --- |" * 10]
+    """The rows as a Markdown table; a dash where a figure does not apply to the engine."""
+    head = ("| engine | triangles | resolution | spp | first image (s) | export (s) | BVH (s) "
+            "| Cycles sync (s) | Cycles other start-up, est. (s) | Mpaths/s | peak RSS (MiB) "
+            "| above Blender and the scene (MiB) |")
+    lines = [head, "|" + " --- |" * (head.count("|") - 1)]
+
+    def cell(row, key):
+        value = row.get(key)
+        return "-" if value is None or value == "" else f"{float(value):.2f}"
+
     for r in rows:
-        export = r.get("export_s", r.get("sync_s", float("nan")))
-        bvh = r.get("bvh_s", r.get("startup_rest_s", float("nan")))
-        lines.append(f"| {r['engine']} | {r['triangles']:,} | {r['width']}x{r['height']} | "
-                     f"{r['samples']} | {r['first_image_s']:.2f} | {export:.2f} | {bvh:.2f} | "
-                     f"{r['mpaths_per_s']:.2f} | {r['rss_peak_mib']:.0f} | {r['render_own_mib']:.0f} |")
+        lines.append(f"| {r['engine']} | {int(r['triangles']):,} | {r['width']}x{r['height']} | "
+                     f"{r['samples']} | {cell(r, 'first_image_s')} | {cell(r, 'export_s')} | "
+                     f"{cell(r, 'bvh_s')} | {cell(r, 'sync_s')} | {cell(r, 'startup_rest_s')} | "
+                     f"{cell(r, 'mpaths_per_s')} | {float(r['rss_peak_mib']):.0f} | "
+                     f"{float(r['render_own_mib']):.0f} |")
     return "\n".join(lines)
 
 

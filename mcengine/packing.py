@@ -83,11 +83,7 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     verts = g.vertices.astype(np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
     if len(tris):
-        p = verts[tris]
-        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        length = np.linalg.norm(cross, axis=1)
-        tri_area = 0.5 * length
-        tri_normal = cross / np.where(length > 0, length, 1.0)[:, None]
+        tri_area, tri_normal = _areas_and_normals(verts, tris)
         lo, hi = verts.min(axis=0), verts.max(axis=0)
     else:
         tri_area = np.zeros(0)
@@ -215,3 +211,22 @@ def pack_objects(g) -> np.ndarray:
         out[:o, OBJ_PASS_INDEX] = info[:, 1]
         out[:o, OBJ_COLOR:OBJ_COLOR + 4] = info[:, 2:6]
     return out
+
+
+def _areas_and_normals(verts, tris, block: int = 1 << 16):
+    """Area and unit geometric normal of every triangle, (T,) and (T, 3) float64.
+
+    Computed in blocks of triangles: whole-array float64 temporaries (the corners
+    alone are 72 bytes per triangle) would cost more in page faults than the
+    arithmetic, and would set the peak memory of large scenes.
+    """
+    t = len(tris)
+    tri_area = np.empty(t)
+    tri_normal = np.empty((t, 3))
+    for a in range(0, t, block):
+        p = verts[tris[a:a + block]]
+        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        length = np.linalg.norm(cross, axis=1)
+        tri_area[a:a + block] = 0.5 * length
+        tri_normal[a:a + block] = cross / np.where(length > 0, length, 1.0)[:, None]
+    return tri_area, tri_normal

@@ -172,9 +172,10 @@ def main(argv=None) -> int:
               f"{warm[0]['compile'] + warm[1]['compile']:.2f} s by drjit's kernel history; kernels "
               f"in drjit's disk cache load without compiling), and each timed render's own code "
               f"generation (tracing, milliseconds) is subtracted")
-        print("Mitsuba: rays/path counted by replaying its path integrator's stopping rules "
-              "(Russian roulette from depth 3 with survival min(throughput, 0.95); Cycles and "
-              "MC Engine use min(sqrt(throughput), 1), so their paths are longer)")
+        print("Mitsuba: rays/path counted by replaying its path integrator's stopping rules. "
+              "Its Russian roulette differs (after sampling at the third vertex, survival "
+              "min(throughput, 0.95); Cycles and MC Engine: at the third vertex, "
+              "min(sqrt(throughput), 1)), so compare Mrays/s as well as Mpaths/s")
         for note in notes:
             print(f"Mitsuba: {note}")
     print_agreement(images)

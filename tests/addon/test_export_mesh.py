@@ -1,4 +1,5 @@
 """Mesh export: world-space triangles, normals, UVs, instancing, materials per triangle."""
+import importlib
 import math
 
 import bpy
@@ -271,3 +272,77 @@ def test_hair_and_visibility_settings_are_named_once(scene, fake_session):
     notes = [w for w in desc.warnings if "ray visibility" in w]
     assert notes == ["ray visibility not supported yet ('Ghost0', 'Ghost1', 'Ghost2', 'Ghost3', "
                      "'Ghost4' and 2 more); these objects are visible to all rays"]
+
+
+def _attribute_grid(n=6):
+    """A smooth n x n grid with two UV maps (the second renders), a byte colour per corner,
+    a float colour per point and a float per face read by its material's Attribute node;
+    returns the mesh and those per-vertex colours and per-face values."""
+    rng = np.random.default_rng(5)
+    grid = bpy.data.meshes.new("Grid")
+    verts = [(x, y, 0.1 * ((x * 7 + y * 3) % 5)) for y in range(n + 1) for x in range(n + 1)]
+    quads = [(y * (n + 1) + x, y * (n + 1) + x + 1, (y + 1) * (n + 1) + x + 1, (y + 1) * (n + 1) + x)
+             for y in range(n) for x in range(n)]
+    grid.from_pydata(verts, [], quads)
+    grid.shade_smooth()
+    for name in ("UVMap", "Second"):
+        grid.uv_layers.new(name=name).uv.foreach_set("vector", rng.random(len(grid.loops) * 2))
+    grid.uv_layers["Second"].active_render = True
+    grid.color_attributes.new("Col", "BYTE_COLOR", "CORNER").data.foreach_set(
+        "color", rng.random(len(grid.loops) * 4))
+    point_colors = rng.random((len(grid.vertices), 4)).astype(np.float32)
+    grid.color_attributes.new("PCol", "FLOAT_COLOR", "POINT").data.foreach_set(
+        "color", point_colors.reshape(-1))
+    weights = rng.random(len(grid.polygons)).astype(np.float32)
+    grid.attributes.new("weight", "FLOAT", "FACE").data.foreach_set("value", weights)
+    mat = bpy.data.materials.new("ReadsWeight")
+    tree = mat.node_tree
+    attr = tree.nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = "weight"
+    tree.links.new(attr.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
+    grid.materials.append(mat)
+    return grid, point_colors, weights
+
+
+def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, addon, monkeypatch):
+    """All instances are written block by block (one instance's range of triangles, or whole
+    instances); any block size gives the same bytes as one block for everything, attributes
+    and per-object data included, and the attributes follow the corners when mirrored
+    instances swap them."""
+    n = 6
+    grid, point_colors, weights = _attribute_grid(n)
+    col = bpy.data.collections.new("Assets")
+    col.objects.link(bpy.data.objects.new("Grid", grid))
+    for i, scale in enumerate([(1, 1, 1), (-1, 2, 1), (0.5, 0.5, 0.5), (1, -1, -1), (2, 1, 1)]):
+        empty = bpy.data.objects.new(f"Inst{i}", None)
+        empty.instance_type, empty.instance_collection = "COLLECTION", col
+        empty.location, empty.rotation_euler, empty.scale = (3 * i, 0, 0), (0.3 * i, 0, 0.2), scale
+        scene.collection.objects.link(empty)
+    cube = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)      # no attributes: zeros there
+    cube.location, cube.pass_index = (0, 5, 0), 3
+    fields = ("vertices", "triangles", "normals", "uvs", "material_index", "object_index",
+              "object_matrix", "object_texspace", "object_info")
+    exports = {}
+    mesh_module = importlib.import_module(f"{addon.__name__}.export.mesh")
+    for block in (1 << 20, 7, 72, 100):     # one block; ranges of one instance; whole instances
+        monkeypatch.setattr(mesh_module, "_BLOCK", block)
+        g = export_scene(fake_session).geometry
+        exports[block] = ([getattr(g, f) for f in fields] + list(g.attributes.values()),
+                          (g.object_names, list(g.attributes)))
+    g = export_scene(fake_session).geometry
+    grid_tris = 5 * 2 * n * n
+    assert g.triangles.shape == (grid_tris + 12, 3)
+    assert set(g.attributes) == {"UVMap", "Second", "Col", "PCol", "weight"}
+    for block, (arrays, names) in exports.items():
+        assert names == exports[1 << 20][1]
+        for name, a, b in zip(fields + tuple(names[1]), arrays, exports[1 << 20][0]):
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), f"{name} differs with blocks of {block}"
+    # Attributes stay with their corners: a point colour is its vertex's, whatever the winding.
+    local_vertex = g.triangles[:grid_tris] % len(grid.vertices)
+    np.testing.assert_array_equal(g.attributes["PCol"][:grid_tris], point_colors[local_vertex])
+    assert np.all(g.attributes["weight"][:grid_tris] == g.attributes["weight"][:grid_tris, :1])
+    np.testing.assert_array_equal(g.attributes["weight"][:grid_tris, 0, 0],
+                                  np.tile(np.repeat(weights, 2), 5))
+    np.testing.assert_array_equal(g.uvs[:grid_tris], g.attributes["Second"][:grid_tris])
+    assert not np.any(g.uvs[grid_tris:]) and not any(np.any(a[grid_tris:]) for a in g.attributes.values())
+    np.testing.assert_array_equal(g.object_info[-1, 1], 3.0)

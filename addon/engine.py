@@ -169,7 +169,7 @@ class MCEngine(bpy.types.RenderEngine):
             self._fail(_describe(exc, "preparing the renderer"), exc)
             return None, None
         if not self.is_preview:
-            _store_effects(depsgraph.scene.original, session.features, exported.ignored)
+            _store_effects(depsgraph.scene.original, session.plan, exported.ignored)
         return exported.scene, session
 
     def _publish(self, result, session, progress) -> None:
@@ -268,15 +268,16 @@ def _describe(exc: Exception, doing: str) -> str:
     return f"failed while {doing}: {type(exc).__name__}: {exc}".splitlines()[0]
 
 
-def _store_effects(scene, features, ignored) -> None:
-    """Remember what the render used (its ``Features``) and ignored, for the MC Engine panel.
+def _store_effects(scene, plan, ignored) -> None:
+    """Remember what the render simulated (its effects plan) and ignored, for the MC Engine
+    panel, the command line and the reports.
 
     Written as ID properties rather than through RNA: the render may run off the
     main thread, and RNA updates would send notifiers from it.
     """
     settings = getattr(scene, "mcengine", None)
     if settings is not None:
-        settings["last_effects"] = features.summary()
+        settings["last_effects"] = plan.summary()
         settings["last_ignored"] = ", ".join(ignored)
 
 

@@ -33,8 +33,8 @@ class MCEngineSceneSettings(bpy.types.PropertyGroup):
         description="Secondary rays per hit in distribution ray tracing")
 
     last_effects: bpy.props.StringProperty(
-        name="Effects",
-        description="What the scene used at the last MC Engine render",
+        name="Effects plan",
+        description="What the last MC Engine render simulated and skipped (its effects plan)",
         default="",
     )
     last_ignored: bpy.props.StringProperty(

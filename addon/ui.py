@@ -56,7 +56,9 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
         if not settings.last_effects:
             col.label(text="Not rendered yet", icon="INFO")
             return
-        col.label(text=settings.last_effects, icon="SHADING_RENDERED")
+        # The effects plan: lights and surfaces | simulated | skipped, one label each.
+        for k, part in enumerate(settings.last_effects.split(" | ")):
+            col.label(text=part[:1].upper() + part[1:], icon="SHADING_RENDERED" if k == 0 else "BLANK1")
         if settings.last_ignored:
             col.label(text=f"Ignored: {settings.last_ignored}", icon="ERROR")
         accounting = settings.get("last_accounting")

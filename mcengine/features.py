@@ -1,73 +1,174 @@
-"""Which effects and light types a scene calls for, decided once per render.
+"""The effects plan: what a render simulates, decided once from the scene.
 
-The render asks this module before it starts, so that no work is done for
-what the scene does not contain: no shadow rays without lights, no lamp
-intersection tests when no lamp can be hit, no background lookups for a black
-world, no hit-by-hit shadow rays unless a material lets light through.  The
-kinds of surface (diffuse, rough or sharp glossy, glass, sheen, ...) are read
-from the shader graphs of the materials the triangles use.  ``summary()`` is
-the line the MC Engine panel shows.
+Before it starts, a render asks this module which effects the scene calls
+for, and the kernels skip the work of the others (flags in the ``cfg``
+settings vector, ``packing``):
+
+==================== ======================================== ======================================
+effect               on when                                  work it costs when on
+==================== ======================================== ======================================
+light sampling       a lamp or emissive triangle gives light  a light sample and a shadow ray per
+                                                              vertex (next-event estimation)
+lamp hits            a lamp has a surface rays can meet       every ray tested against the lamps,
+                     (radius, size, sun angle; MIS on)        escaped rays against suns
+MIS weights          light can be both sampled and hit        light-picking sums at every vertex for
+                     (lamp hits, emissive triangles)          the weights of emission found by rays
+world lookups        the world is not black                   background radiance for escaped rays
+transparent shadows  a material lets shadow rays through      shadow rays traced hit by hit, with the
+                                                              shader run at every surface they pass
+caustic paths        lights, a glossy/glass/refraction caster Filter Glossy and the caustics switches
+                     and a diffuse receiver                   at every vertex; light subpaths of
+                                                              bidirectional path tracing
+==================== ======================================== ======================================
+
+Besides the effects, the plan lists what the scene holds: light types, the
+kinds of surface (read from the materials' shader graphs) and the materials
+whose shaders evaluate nodes at every hit (textures, inputs) rather than only
+build closures from constants.  ``summary()`` is the line shown in the MC
+Engine panel, on the command line and in the comparison and study reports.
+
+Every effect can be forced on (``RenderSession(..., force_effects=...)``):
+the benchmark (``benchmarks/bench_effects_plan.py``) measures what the plan
+saves that way, and the tests check that forcing on an effect the scene does
+not call for leaves the image bit for bit the same.
 """
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .kernels.state import MF_TRANSPARENT
+from .kernels.state import (
+    CFG_CAUSTICS,
+    CFG_LAMPS_HIT,
+    CFG_LIGHTS,
+    CFG_MIS,
+    CFG_TRANSPARENT_SHADOWS,
+    CFG_WORLD,
+    MF_TRANSPARENT,
+)
+from .kernels.svm import OP_NODE
 from .scene import Link
+
+# Effect name -> (label for people, cfg flag that switches it in the kernels).
+EFFECTS = {
+    "nee": ("light sampling", CFG_LIGHTS),
+    "lamps_hit": ("lamp hits", CFG_LAMPS_HIT),
+    "mis": ("MIS weights", CFG_MIS),
+    "world": ("world lookups", CFG_WORLD),
+    "transparent_shadows": ("transparent shadows", CFG_TRANSPARENT_SHADOWS),
+    "caustics": ("caustic paths", CFG_CAUSTICS),
+}
 
 
 @dataclass(frozen=True)
-class Features:
+class EffectsPlan:
     lamp_types: dict = field(default_factory=dict)   # e.g. {"AREA": 2, "POINT": 1}
     emissive_triangles: int = 0
-    world: bool = False            # the background is not black
-    lamps_hit: bool = False        # some lamp can be hit by camera or BSDF rays
-    nee: bool = False              # something to sample with next-event estimation
     lobes: tuple = ()              # kinds of surface, in LOBE_ORDER
-    transparent_shadows: bool = False   # shadow rays pass some material's transparency
+    textures: int = 0              # materials whose shaders evaluate nodes at every hit
+    # The effects (see the module docstring); each is a kernel flag.
+    nee: bool = False
+    lamps_hit: bool = False
+    mis: bool = False
+    world: bool = False
+    transparent_shadows: bool = False
+    caustics: bool = False
+    forced: tuple = ()             # effects forced on although the scene does not call for them
+
+    def force(self, names) -> "EffectsPlan":
+        """This plan with the effects ``names`` (or every effect for "all") switched on."""
+        names = tuple(EFFECTS) if names == "all" else tuple(names)
+        unknown = [n for n in names if n not in EFFECTS]
+        if unknown:
+            raise ValueError(f"unknown effect {unknown[0]!r} (choose from {', '.join(EFFECTS)})")
+        added = tuple(n for n in names if not getattr(self, n))
+        return replace(self, forced=self.forced + added, **{n: True for n in names})
+
+    def effects_on(self) -> tuple:
+        return tuple(n for n in EFFECTS if getattr(self, n))
+
+    def flags(self, cfg) -> None:
+        """Write the effects into the kernels' settings vector."""
+        for name, (_, index) in EFFECTS.items():
+            cfg[index] = 1 if getattr(self, name) else 0
 
     def summary(self) -> str:
-        """One line for the UI and the logs."""
+        """One line: the lights and surfaces, then what is simulated and what is skipped."""
         lights = [f"{n} {t.lower()}" for t, n in sorted(self.lamp_types.items())]
         if self.emissive_triangles:
             n = self.emissive_triangles
             lights.append(f"{n} emissive triangle{'s' if n > 1 else ''}")
         if self.world:
             lights.append("world")
+        on = [EFFECTS[n][0] + (" (forced)" if n in self.forced else "") for n in self.effects_on()]
+        off = [EFFECTS[n][0] for n in EFFECTS if not getattr(self, n)]
+        textures = (f"{self.textures} textured material{'s' if self.textures > 1 else ''}"
+                    if self.textures else "no textures")
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
-                f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}")
+                f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures} | "
+                f"simulated: {', '.join(on) if on else 'nothing'} | "
+                f"skipped: {', '.join(off) if off else 'nothing'}")
 
 
-def lamp_can_be_hit(light) -> bool:
-    """Cycles: a lamp is intersectable if it has a surface and MIS (or camera visibility)."""
+def lamp_has_surface(light) -> bool:
+    """Whether rays can meet the lamp: a radius, a sun angle, an area."""
     if light.type in ("POINT", "SPOT"):
-        has_surface = light.radius > 0.0
-    elif light.type == "SUN":
-        has_surface = light.angle > 0.0
-    else:
-        has_surface = light.size_x > 0.0 and light.size_y > 0.0
-    return has_surface and light.use_mis
+        return light.radius > 0.0
+    if light.type == "SUN":
+        return light.angle > 0.0
+    return light.size_x > 0.0 and light.size_y > 0.0
 
 
-def detect(scene, emissive_triangles: int, lamp_power, material_flags) -> Features:
-    """Features of ``scene`` given its emissive triangle count, lamp powers and the MF_*
-    flags of its materials."""
+def lamps_intersectable(lights) -> bool:
+    """Cycles' use_light_mis: rays test lamps at all only if a point or spot lamp with a
+    radius, or an area lamp, has MIS on (scene/light.cpp); otherwise not even a lamp
+    visible to the camera is seen (``packing`` clears that visibility)."""
+    return any(li.use_mis and (li.type == "AREA" or (li.type in ("POINT", "SPOT") and li.radius > 0))
+               for li in lights)
+
+
+def lamps_hit_by_rays(lights) -> bool:
+    """Whether some lamp can be met by a ray: an intersectable lamp with a surface, or a
+    sun with an angle and MIS on (met by escaped rays)."""
+    if any(li.type == "SUN" and li.use_mis and lamp_has_surface(li) for li in lights):
+        return True
+    return lamps_intersectable(lights) and any(
+        lamp_has_surface(li) and (li.use_mis or li.visible_camera)
+        for li in lights if li.type != "SUN")
+
+
+CASTERS = {"rough glossy", "sharp glossy", "coat", "rough glass", "sharp glass",
+           "rough refraction", "sharp refraction"}
+RECEIVERS = {"diffuse", "rough diffuse", "sheen", "translucent"}
+
+
+def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=None) -> EffectsPlan:
+    """The plan for ``scene`` given its emissive triangle count, lamp powers, the MF_*
+    flags of its materials and their shader programs (``(ops, ranges)``)."""
     lamps = [li for li, pw in zip(scene.lights, lamp_power) if pw > 0.0]
     used = sorted(set(np.unique(scene.geometry.material_index).tolist()))
     kinds = set()
     for i in used:
         kinds |= surface_kinds(scene.materials[i])
-    return Features(
+    lamps_hit = lamps_hit_by_rays(lamps)
+    nee = bool(lamps) or emissive_triangles > 0
+    textures = 0
+    if programs is not None:
+        ops, ranges = programs
+        textures = sum(1 for i in used if np.any(ops[ranges[i][0]:ranges[i][1], 0] == OP_NODE))
+    return EffectsPlan(
         lobes=tuple(k for k in LOBE_ORDER if k in kinds),
+        textures=textures,
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
         world=bool(np.max(np.asarray(scene.world.color, float)) > 0.0),
-        lamps_hit=any(lamp_can_be_hit(li) for li in lamps if li.type != "SUN"),
-        nee=bool(lamps) or emissive_triangles > 0,
+        lamps_hit=lamps_hit,
+        nee=nee,
+        mis=nee and (lamps_hit or emissive_triangles > 0),
+        caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
     )
 
 

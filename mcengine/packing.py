@@ -4,7 +4,7 @@ The scene model (``scene``) is made for people and files; the kernels want
 contiguous float64/int32 tables with fixed columns (``kernels.state``,
 ``kernels.lights``, ``kernels.camera``), the shader programs (``shaders``), the light
 picking distributions, and two small settings vectors (``cfg`` integers,
-``fcfg`` floats) that also carry the decisions of ``features``.  This module
+``fcfg`` floats) that also carry the effects plan of ``features``.  This module
 builds all of them once per render.
 """
 from __future__ import annotations
@@ -14,11 +14,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .features import Features
-from .features import detect as detect_features
+from .features import EffectsPlan, lamps_intersectable
+from .features import detect as detect_plan
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
-from .kernels.lights import L_PMF, LIGHT_STRIDE, pack_lights
+from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
 from .kernels.sampling import filter_table
 from .kernels.shading import emission_estimates
 from .kernels.state import (
@@ -26,8 +26,6 @@ from .kernels.state import (
     CFG_CAUSTICS_REFRACTIVE,
     CFG_FILM_TRANSPARENT,
     CFG_FULL_W,
-    CFG_LAMPS_HIT,
-    CFG_LIGHTS,
     CFG_LOCAL_LIGHTS,
     CFG_MAX_BOUNCE,
     CFG_MAX_DIFFUSE,
@@ -40,8 +38,6 @@ from .kernels.state import (
     CFG_REGION_Y,
     CFG_SEED,
     CFG_SIZE,
-    CFG_TRANSPARENT_SHADOWS,
-    CFG_WORLD,
     CFG_WORLD_CAMERA,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
@@ -74,11 +70,15 @@ class PackedScene(NamedTuple):
     sc: SceneData          # the scene's tables
     cfg: np.ndarray        # (CFG_SIZE,) int64 settings
     fcfg: np.ndarray       # (FCFG_SIZE,) float64 settings
-    features: Features     # what the scene calls for
+    plan: EffectsPlan      # what the scene calls for (``features``)
 
 
-def pack_scene(scene: SceneDescription) -> PackedScene:
-    """Pack a scene description into the kernels' arrays (see :class:`PackedScene`)."""
+def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
+    """Pack a scene description into the kernels' arrays (see :class:`PackedScene`).
+
+    ``force_effects`` names effects of the plan to switch on although the scene
+    does not call for them ("all" for every one): for the benchmark and the tests.
+    """
     g = scene.geometry
     verts = g.vertices.astype(np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
@@ -145,7 +145,15 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
         emit_group[4] = emit_power.sum() / math.pi
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
-    feats = detect_features(scene, len(emit_tri), lamp_power, shaders.flags)
+        if not lamps_intersectable(scene.lights):
+            # Cycles tests no lamp at all then: not even one visible to the camera.
+            not_sun = lamps[:, L_TYPE] != LT_SUN
+            lamps[not_sun, L_FLAGS] = (lamps[not_sun, L_FLAGS].astype(np.int64) & ~LF_VIS_CAMERA)
+    plan = detect_plan(scene, len(emit_tri), lamp_power, shaders.flags,
+                       (shaders.ops, shaders.ranges))
+    if force_effects:
+        plan = plan.force(force_effects)
+
     x0, y0, x1, y1 = film.window
     sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,
                      emit_cdf=emit_cdf, emit_group=emit_group, tri_light=tri_light)
@@ -161,14 +169,11 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     cfg[CFG_SEED] = it.seed & 0x7FFFFFFFFFFFFFFF
     cfg[CFG_FILM_TRANSPARENT] = 1 if film.transparent else 0
     cfg[CFG_WORLD_CAMERA] = 1 if scene.world.visible_camera else 0
-    cfg[CFG_LAMPS_HIT] = 1 if feats.lamps_hit else 0
     cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W] = x0, y0, x1 - x0
     cfg[CFG_FULL_W] = film.width
-    cfg[CFG_LIGHTS] = 1 if feats.nee else 0
-    cfg[CFG_WORLD] = 1 if feats.world else 0
     cfg[CFG_CAUSTICS_REFLECTIVE] = 1 if it.caustics_reflective else 0
     cfg[CFG_CAUSTICS_REFRACTIVE] = 1 if it.caustics_refractive else 0
-    cfg[CFG_TRANSPARENT_SHADOWS] = 1 if feats.transparent_shadows else 0
+    plan.flags(cfg)
     fcfg = np.zeros(FCFG_SIZE)
     fcfg[FCFG_FILTER_GLOSSY] = it.filter_glossy
     # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.
@@ -180,7 +185,7 @@ def pack_scene(scene: SceneDescription) -> PackedScene:
     # the scan over lamps stays short.
     n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
     cfg[CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
-    return PackedScene(sc, cfg, fcfg, feats)
+    return PackedScene(sc, cfg, fcfg, plan)
 
 
 def pack_attributes(g) -> tuple[AttributeLayout, np.ndarray]:

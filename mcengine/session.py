@@ -205,13 +205,15 @@ class RenderSession:
     """A render of one scene description; see the module docstring."""
 
     def __init__(self, scene: SceneDescription, *, threads: int | None = None,
-                 batch_size: int | None = None, host_bytes_per_pixel: int = 0):
+                 batch_size: int | None = None, host_bytes_per_pixel: int = 0,
+                 force_effects=()):
         self.scene = scene.validate()
         self.threads = int(threads or default_threads())
         self.batch_size = int(batch_size or DEFAULT_BATCH)
         it = scene.integrator
         self.stats = RenderStats(samples_target=it.samples)
-        self.sc, self.cfg, self.fcfg, self.features = pack_scene(scene)
+        # The effects plan (``features``): what the scene calls for, as kernel flags.
+        self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
         self.integrator = integrator_info(it.name)
         self._classic_setup()
         x0, y0, x1, y1 = scene.film.window

@@ -115,7 +115,11 @@ def _render_runs(scene, engine: str, options: CompareOptions, size, render, on_r
             raise CompareError(f"{engine} render failed: {error_message(exc)}") from None
     notes = []
     if engine == "mcengine":
-        ignored = getattr(getattr(scene, "mcengine", None), "last_ignored", "")
+        settings = getattr(scene, "mcengine", None)
+        plan = getattr(settings, "last_effects", "")
+        if plan:
+            notes.append(f"MC Engine's effects plan: {plan}.")
+        ignored = getattr(settings, "last_ignored", "")
         if ignored:
             notes.append(f"MC Engine does not support, and rendered without: {ignored}. "
                          f"Where these matter, \"differ\" is expected.")

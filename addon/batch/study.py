@@ -146,6 +146,9 @@ def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySe
         study = run_study(render_one, options, scene=name or scene.name,
                           settings=_descriptions(chosen, options.integrators),
                           notes=[TIMING_NOTE], on_render=on_render)
+    plan = scene.mcengine.last_effects
+    if options.integrators and plan:
+        study.notes.append(f"MC Engine's effects plan (its last render): {plan}.")
     ignored = scene.mcengine.last_ignored
     if options.integrators and ignored:
         study.notes.append(f"MC Engine does not support, and rendered without: "

@@ -309,6 +309,9 @@ def run_render(request: RenderRequest) -> int:
     _summary(log.console, scene, request, frames, rendered, skipped, samples,
              time.monotonic() - started)
     if ours and rendered and not by_frame:
+        plan = getattr(getattr(scene, "mcengine", None), "last_effects", "")
+        if plan:
+            log.console.write(f"{PROG}: plan: {plan}\n")
         accounting = _ray_accounting()
         if accounting:
             log.console.write(f"{PROG}: {accounting}\n")

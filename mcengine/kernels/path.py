@@ -68,6 +68,7 @@ from .shading import (
 )
 from .shadows import trace_shadows
 from .state import (
+    CFG_CAUSTICS,
     CFG_LAMPS_HIT,
     CFG_LIGHTS,
     CFG_LOCAL_LIGHTS,
@@ -77,6 +78,7 @@ from .state import (
     CFG_MAX_TRANSMISSION,
     CFG_MAX_TRANSPARENT,
     CFG_MIN_LIGHT_BOUNCES,
+    CFG_MIS,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     MF_EMISSIVE,
@@ -98,6 +100,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
     n_shadow = 0
     n_lamps = sc.lamps.shape[0]
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    mis = cfg[CFG_MIS] != 0
+    caustics = cfg[CFG_CAUSTICS] != 0
+    nee = cfg[CFG_LIGHTS] != 0 and sc.light_cdf.shape[0] > 1
     local = cfg[CFG_LOCAL_LIGHTS] != 0
     pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
     has_group = sc.emit_tri.shape[0] > 0
@@ -121,7 +126,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         # Light-picking probabilities at the vertex this ray left, for MIS.
         mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
         mis_total = 0.0
-        if local and not (flags & PF_MIS_SKIP):
+        if local and mis and not (flags & PF_MIS_SKIP):
             mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, mpx, mpy, mpz)
 
         # -- light arriving along the ray ------------------------------------------------------
@@ -164,7 +169,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         if terminate or res.n == 0:
             continue
         ncl = res.n
-        if fcfg[FCFG_FILTER_GLOSSY] > 0.0:
+        if caustics and fcfg[FCFG_FILTER_GLOSSY] > 0.0:
             blur_closures(scratch.cl, ncl, fcfg[FCFG_FILTER_GLOSSY] * st.min_pdf[i])
 
         # Russian roulette (Cycles: from the third vertex on, with the
@@ -182,7 +187,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
                 st.beta[i, 2] /= q
 
         # -- next-event estimation: one light --------------------------------------------------
-        if cfg[CFG_LIGHTS]:
+        if nee:
             u_pick = rand(key, bounce_dim(vertex, DIM_LIGHT_PICK))
             if local:
                 idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, sp.hx, sp.hy, sp.hz,

@@ -55,6 +55,7 @@ from .state import (
     CFG_CAUSTICS_REFLECTIVE,
     CFG_CAUSTICS_REFRACTIVE,
     CFG_FILM_TRANSPARENT,
+    CFG_LAMPS_HIT,
     CFG_MAX_TRANSPARENT,
     CFG_WORLD,
     CFG_WORLD_CAMERA,
@@ -205,7 +206,7 @@ def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, f
     if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
         add_light(out, row, beta[i, 0] * sc.world[0], beta[i, 1] * sc.world[1],
                   beta[i, 2] * sc.world[2], direct, fcfg, stats)
-    if sc.lamps.shape[0]:
+    if sc.lamps.shape[0] and cfg[CFG_LAMPS_HIT]:
         lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
                                mpx, mpy, mpz, mis_total)
         if lr != 0.0 or lg != 0.0 or lb != 0.0:

@@ -115,13 +115,15 @@ CFG_REGION_X = 10         # film region origin and width in the full frame
 CFG_REGION_Y = 11
 CFG_REGION_W = 12
 CFG_FULL_W = 13
-CFG_LIGHTS = 14           # NEE has something to sample
+CFG_LIGHTS = 14           # next-event estimation has something to sample
 CFG_WORLD = 15            # the world is not black
 CFG_LOCAL_LIGHTS = 16     # pick lights by their estimated irradiance at each point
 CFG_CAUSTICS_REFLECTIVE = 17   # glossy reflection after a diffuse bounce (Cycles' switches)
 CFG_CAUSTICS_REFRACTIVE = 18
 CFG_TRANSPARENT_SHADOWS = 19   # some material lets shadow rays through: trace them hit by hit
-CFG_SIZE = 20
+CFG_MIS = 20              # emission found by rays gets MIS weights (some light is sampled and hit)
+CFG_CAUSTICS = 21         # caustic paths: Filter Glossy and the caustics switches apply
+CFG_SIZE = 22
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1

@@ -64,7 +64,7 @@ class GradientSession:
         self._image = np.zeros_like(self.target)
         self.samples_done = 0
         self.stats = SimpleNamespace(rays_per_second=2.5e6, eta_seconds=3.0)
-        self.features = pack_scene(desc).features
+        self.plan = pack_scene(desc).plan
         self.pass_images = []
 
     def run(self, on_pass=None, should_stop=None):

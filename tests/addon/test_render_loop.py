@@ -86,10 +86,14 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
     panel_lines = _panel_text(addon, scene)
     assert panel_lines == ["Not rendered yet"]
     bpy.ops.render.render()
-    line = "Lights: 1 sun, 1 emissive triangle; surfaces: diffuse, rough glossy, emission"
-    assert scene.mcengine.last_effects == line
+    parts = ["Lights: 1 sun, 1 emissive triangle; surfaces: diffuse, rough glossy, emission; "
+             "no textures",
+             "simulated: light sampling, lamp hits, MIS weights, caustic paths",
+             "skipped: world lookups, transparent shadows"]
+    assert scene.mcengine.last_effects == " | ".join(parts)
     assert scene.mcengine.last_ignored == "denoising"
-    assert _panel_text(addon, scene) == [line,
+    assert _panel_text(addon, scene) == [parts[0], "Simulated: " + parts[1][len("simulated: "):],
+                                         "Skipped: " + parts[2][len("skipped: "):],
                                          "Ignored: denoising"]
 
 

@@ -6,14 +6,23 @@ the engine reads ``scene.cycles`` for those (see ``export.settings``).
 # No "from __future__ import annotations": bpy reads the property annotations as objects.
 import bpy
 
-from mcengine import integrators
+from mcengine import integrators, samplers
 
-__all__ = ["MCEngineSceneSettings", "register", "unregister"]
+__all__ = ["MCEngineSceneSettings", "SAMPLER_AS_CYCLES", "register", "unregister"]
 
 # The integrator enum's items, from the registry.  A .blend stores the index, so new
 # integrators go at the end of the registry.
 INTEGRATOR_ITEMS = [(info.enum_id, info.label, info.description, index)
                     for index, info in enumerate(integrators.INTEGRATORS.values())]
+
+# The sampler enum: "As Cycles" (the sampler matching Cycles' Sampling Pattern), then the
+# registry's samplers; new samplers go at the end.
+SAMPLER_AS_CYCLES = "AUTOMATIC"
+SAMPLER_ITEMS = [(SAMPLER_AS_CYCLES, "As Cycles",
+                  "The sampler matching Cycles' Sampling Pattern: scrambled Sobol for every "
+                  "pattern Cycles offers", 0)] + [
+    (info.enum_id, info.label, info.description, index + 1)
+    for index, info in enumerate(samplers.SAMPLERS.values())]
 
 
 class MCEngineSceneSettings(bpy.types.PropertyGroup):
@@ -31,6 +40,10 @@ class MCEngineSceneSettings(bpy.types.PropertyGroup):
         name="Branching", default=integrators.DEFAULT_BRANCHING,
         min=integrators.BRANCHING_RANGE[0], max=integrators.BRANCHING_RANGE[1],
         description="Secondary rays per hit in distribution ray tracing")
+    sampler: bpy.props.EnumProperty(
+        name="Sampler", items=SAMPLER_ITEMS, default=SAMPLER_AS_CYCLES,
+        description="Random numbers of the path tracer (the other integrators draw "
+                    "independent numbers)")
 
     last_effects: bpy.props.StringProperty(
         name="Effects plan",

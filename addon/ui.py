@@ -69,12 +69,15 @@ class MCENGINE_RENDER_PT_engine(bpy.types.Panel):
 
 
 def _draw_integrator(layout, settings) -> None:
-    """The integrator and, where they apply, its depth and branching."""
+    """The integrator and, where they apply, its depth and branching; the sampler."""
     col = layout.column()
     col.use_property_split = True
     col.use_property_decorate = False
     col.prop(settings, "integrator")
     info = from_enum(settings.integrator)
+    row = col.row()
+    row.active = info.uses_sampler
+    row.prop(settings, "sampler")
     if info.uses_depth:
         col.prop(settings, "depth")
     if info.uses_branching:

@@ -34,8 +34,13 @@ only approximately the same BSDF).
 Mitsuba comes from the optional ``bench`` extra (``pip install -e '.[bench]'``);
 drjit needs a libLLVM >= 16, found on its own or named by DRJIT_LIBLLVM_PATH.
 
+MC Engine renders with ``--sampler`` (default ``sobol``, what a user gets; Mitsuba
+and Cycles' path counts do not depend on it); ``benchmarks/bench_sampler.py``
+compares the samplers' error per second.
+
 Run: python benchmarks/bench_cornell.py [--samples N] [--resolution N] [--rounds R]
                                         [--materials file|principled] [--no-mitsuba]
+                                        [--sampler sobol|independent]
 """
 from __future__ import annotations
 
@@ -50,6 +55,8 @@ from pathlib import Path
 import mitsuba_peer
 import numpy as np
 
+from mcengine import samplers
+
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "blend_scenes" / "cornell_box.blend"
 
@@ -62,6 +69,8 @@ def main(argv=None) -> int:
     ap.add_argument("--materials", choices=("file", "principled"), default="file",
                     help="the file's Lambert materials, or every surface the default Principled "
                          "BSDF of the same base colour (the light keeps its emission)")
+    ap.add_argument("--sampler", choices=samplers.NAMES, default=samplers.DEFAULT,
+                    help=f"MC Engine's sampler (default: {samplers.DEFAULT})")
     ap.add_argument("--no-mitsuba", action="store_true",
                     help="leave Mitsuba 3 out (it needs the 'bench' extra: pip install -e '.[bench]')")
     args = ap.parse_args(argv)
@@ -96,6 +105,7 @@ def main(argv=None) -> int:
     def run(bl_engine, samples):
         scene = open_scene(SCENE)
         make_unbiased(scene)
+        scene.mcengine.sampler = samplers.get(args.sampler).enum_id
         if args.materials == "principled":
             to_default_principled(bpy)
         return render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
@@ -146,7 +156,8 @@ def main(argv=None) -> int:
     buffers = session.buffer_bytes
     print()
     print(f"Cornell box ({args.materials} materials) {args.resolution}x{args.resolution}, "
-          f"{args.samples} spp, 8 bounces, medians of {args.rounds} rounds")
+          f"{args.samples} spp, 8 bounces, medians of {args.rounds} rounds, MC Engine's "
+          f"sampler {args.sampler}")
     print(f"{'':12s}{'wall Mpaths/s':>15s}{'marginal Mpaths/s':>20s}{'rays/path':>12s}"
           f"{'marginal Mrays/s':>18s}  (Cycles: the same paths as MC Engine)")
     # Cycles traces the same light paths as MC Engine (same rules); its rays are not counted.

@@ -40,6 +40,12 @@ class IntegratorInfo:
     # glass (nothing for its extra rays to follow), or "".
     reduces_to: str = ""
 
+    @property
+    def uses_sampler(self) -> bool:
+        """Draws its numbers from the scene's sampler (``Integrator.sampler``); the classic
+        integrators' ray trees always draw independent numbers."""
+        return self.kernel_code == 0
+
     def rays_per_sample(self, depth: int, branching: int) -> int:
         """Most closest-hit rays one camera sample casts: 1, 2^r - 1 or 1 + b + ... + b^(r-1)."""
         if not self.uses_depth:

@@ -14,13 +14,15 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import integrators, samplers
 from .features import EffectsPlan, lamps_intersectable
 from .features import detect as detect_plan
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
-from .kernels.sampling import filter_table
+from .kernels.sampling import SAMPLER_INDEPENDENT, filter_table
 from .kernels.shading import emission_estimates
+from .kernels.sobol import index_mask
 from .kernels.state import (
     CFG_CAUSTICS_REFLECTIVE,
     CFG_CAUSTICS_REFRACTIVE,
@@ -36,8 +38,10 @@ from .kernels.state import (
     CFG_REGION_W,
     CFG_REGION_X,
     CFG_REGION_Y,
+    CFG_SAMPLER,
     CFG_SEED,
     CFG_SIZE,
+    CFG_SOBOL_MASK,
     CFG_WORLD_CAMERA,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
@@ -71,6 +75,14 @@ class PackedScene(NamedTuple):
     cfg: np.ndarray        # (CFG_SIZE,) int64 settings
     fcfg: np.ndarray       # (FCFG_SIZE,) float64 settings
     plan: EffectsPlan      # what the scene calls for (``features``)
+
+
+def sampler_code(it) -> int:
+    """The kernels' sampler: the scene's for the path tracer; the classic integrators'
+    ray trees always draw independent numbers."""
+    if not integrators.get(it.name).uses_sampler:
+        return SAMPLER_INDEPENDENT
+    return samplers.get(it.sampler).kernel_code
 
 
 def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
@@ -174,6 +186,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     cfg[CFG_CAUSTICS_REFLECTIVE] = 1 if it.caustics_reflective else 0
     cfg[CFG_CAUSTICS_REFRACTIVE] = 1 if it.caustics_refractive else 0
     plan.flags(cfg)
+    cfg[CFG_SAMPLER] = sampler_code(it)
+    cfg[CFG_SOBOL_MASK] = index_mask(it.samples)
     fcfg = np.zeros(FCFG_SIZE)
     fcfg[FCFG_FILTER_GLOSSY] = it.filter_glossy
     # Cycles compares |r|+|g|+|b| with 3x the clamp setting; 0 means off.

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import integrators, memory
+from . import integrators, memory, samplers
 
 __all__ = [
     "SceneError", "Geometry", "Link", "ShaderNode", "Material", "Light", "Camera", "World", "Film",
@@ -376,12 +376,15 @@ class Integrator:
     "path" (path tracing, the default and the only one that matches Cycles),
     "raycast", "whitted" (mirror and refraction rays down to ``depth`` ray
     levels) or "distribution" (``branching`` rays at every hit, ``depth``
-    levels).
+    levels).  ``sampler`` chooses the random numbers of the path tracer, one of
+    :data:`mcengine.samplers.NAMES`: "sobol" (scrambled Sobol, as Cycles) or
+    "independent" (the lecture's independent numbers).
     """
 
     name: str = integrators.DEFAULT
     depth: int = integrators.DEFAULT_DEPTH
     branching: int = integrators.DEFAULT_BRANCHING
+    sampler: str = samplers.DEFAULT
     samples: int = 64
     seed: int = 0
     max_bounces: int = 12
@@ -510,6 +513,7 @@ class SceneDescription:
         try:
             integrators.get(i.name)
             integrators.check_parameters(i.depth, i.branching)
+            samplers.get(i.sampler)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
         _check_number("integrator", "samples", i.samples, lo=1, hi=MAX_SAMPLES)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 
 from mcengine.integrators import get as get_integrator
+from mcengine.samplers import get as get_sampler
 
 __all__ = ["apply_overrides", "set_image_format", "make_unbiased", "TOUCHED_SETTINGS",
            "restoring"]
@@ -20,7 +21,7 @@ __all__ = ["apply_overrides", "set_image_format", "make_unbiased", "TOUCHED_SETT
 
 def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=None,
                     threads=None, frame=None, integrator=None, depth=None,
-                    branching=None, overwrite=None, placeholders=None) -> None:
+                    branching=None, overwrite=None, placeholders=None, sampler=None) -> None:
     """Change the settings of the next render in memory; None keeps the scene's.
 
     engine      RenderEngine bl_idname ("MCENGINE", "CYCLES")
@@ -35,6 +36,7 @@ def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=N
     overwrite, placeholders
                 Output > Overwrite and Placeholders (``render.use_overwrite``,
                 ``render.use_placeholder``), read by the command line's frames
+    sampler     MC Engine's sampler (a name of :mod:`mcengine.samplers`); likewise
     """
     render = scene.render
     if engine is not None:
@@ -64,6 +66,8 @@ def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=N
             own.depth = depth
         if branching is not None:
             own.branching = branching
+        if sampler is not None:
+            own.sampler = get_sampler(sampler).enum_id
 
 
 def set_image_format(scene, file_format: str) -> None:
@@ -110,6 +114,7 @@ TOUCHED_SETTINGS = (
     ("cycles", "time_limit"), ("cycles", "use_layer_samples"),
     ("view_settings", "view_transform"), ("view_settings", "look"),
     ("mcengine", "integrator"), ("mcengine", "depth"), ("mcengine", "branching"),
+    ("mcengine", "sampler"),
 )
 
 

@@ -32,7 +32,10 @@ from pathlib import Path
 from mcengine.evaluation.study import CYCLES, Study, StudyError, StudyOptions, run_study
 from mcengine.integrators import INTEGRATORS
 from mcengine.integrators import get as get_integrator
+from mcengine.samplers import DEFAULT as DEFAULT_SAMPLER
+from mcengine.samplers import get as get_sampler
 
+from ..export.settings import sampler_for
 from .comparison import matched_settings
 from .render import OpenError, ensure_registered, error_message, open_scene, render_scene
 from .settings import apply_overrides, restoring
@@ -64,12 +67,15 @@ class StudySettings:
                 depth for Whitted, DISTRIBUTION_DEPTH for distribution
     branching   rays per hit of distribution ray tracing; None: DISTRIBUTION_BRANCHING
     threads     CPU threads (0 = all); None keeps the scene's setting
+    sampler     the path tracer's sampler (a name of mcengine.samplers), for its ladder and
+                its reference; None keeps the scene's setting
     """
 
     resolution: tuple | None = None
     depth: int | None = None
     branching: int | None = None
     threads: int | None = None
+    sampler: str | None = None
 
 
 def _integrator_settings(scene, settings: StudySettings) -> dict:
@@ -90,11 +96,14 @@ def _integrator_settings(scene, settings: StudySettings) -> dict:
     return chosen
 
 
-def _descriptions(chosen: dict, integrators) -> dict:
+def _descriptions(chosen: dict, integrators, sampler) -> dict:
     """Integrator -> one-line description of the settings it uses, for the report."""
     out = {}
     for name in integrators:
-        text = get_integrator(name).settings_text(*chosen[name])
+        info = get_integrator(name)
+        parts = [info.settings_text(*chosen[name]),
+                 f"{sampler.label} sampler" if info.uses_sampler else ""]
+        text = "; ".join(part for part in parts if part)
         if text:
             out[name] = text
     return out
@@ -131,7 +140,8 @@ def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySe
     chosen = _integrator_settings(scene, settings)
     with restoring(scene):
         matched_settings(scene)
-        apply_overrides(scene, resolution=settings.resolution, threads=settings.threads)
+        apply_overrides(scene, resolution=settings.resolution, threads=settings.threads,
+                        sampler=settings.sampler)
 
         def render_one(integrator, samples, seed):
             engine = "cycles" if integrator == CYCLES else "mcengine"
@@ -143,8 +153,9 @@ def study_scene(scene, options: StudyOptions = StudyOptions(), settings: StudySe
             except RuntimeError as exc:
                 raise StudyError(f"{integrator} render failed: {error_message(exc)}") from None
 
+        sampler = sampler_for(scene, scene.cycles) or get_sampler(DEFAULT_SAMPLER)
         study = run_study(render_one, options, scene=name or scene.name,
-                          settings=_descriptions(chosen, options.integrators),
+                          settings=_descriptions(chosen, options.integrators, sampler),
                           notes=[TIMING_NOTE], on_render=on_render)
     plan = scene.mcengine.last_effects
     if options.integrators and plan:

@@ -25,6 +25,7 @@ from mcengine.evaluation.study import DEFAULT_SEEDS as STUDY_SEEDS
 from mcengine.integrators import BRANCHING_RANGE, DEPTH_RANGE, INTEGRATORS
 from mcengine.integrators import DEFAULT as DEFAULT_INTEGRATOR
 from mcengine.integrators import NAMES as INTEGRATOR_NAMES
+from mcengine.samplers import NAMES as SAMPLER_NAMES
 
 from ..batch.render import ENGINES
 from .errors import PROG, CliError
@@ -152,6 +153,14 @@ def _integrator_list(text: str) -> tuple[str, ...]:
     return names
 
 
+def _sampler(text: str) -> str:
+    name = text.lower()
+    if name not in SAMPLER_NAMES:
+        raise argparse.ArgumentTypeError(
+            f"unknown sampler {text!r} (choose from {', '.join(SAMPLER_NAMES)})")
+    return name
+
+
 def _depth(text: str) -> int:
     return _positive_int(text, "depth", DEPTH_RANGE[1], DEPTH_RANGE[0])
 
@@ -161,7 +170,7 @@ def _branching(text: str) -> int:
 
 
 def _readers(parameter: str) -> list[str]:
-    """Names of the integrators that read ``parameter`` ("depth" or "branching")."""
+    """Names of the integrators that read ``parameter`` ("depth", "branching", "sampler")."""
     return [name for name, info in INTEGRATORS.items() if getattr(info, f"uses_{parameter}")]
 
 
@@ -172,7 +181,7 @@ def _in_words(names) -> str:
 
 
 def _add_integrator_options(parser, for_study: bool = False) -> None:
-    """--depth and --branching (and --integrator for a render)."""
+    """--depth, --branching and --sampler (and --integrator for a render)."""
     if not for_study:
         choices = [f"{name} (default)" if name == DEFAULT_INTEGRATOR else name
                    for name in INTEGRATOR_NAMES]
@@ -185,16 +194,20 @@ def _add_integrator_options(parser, for_study: bool = False) -> None:
     parser.add_argument("--branching", type=_branching, default=None, metavar="B",
                         help=f"rays per hit of {' and '.join(_readers('branching'))}, "
                              f"{BRANCHING_RANGE[0]}..{BRANCHING_RANGE[1]}")
+    parser.add_argument("--sampler", type=_sampler, default=None,
+                        help=f"random numbers of the {_in_words(_readers('sampler'))} "
+                             f"integrator: {_in_words(SAMPLER_NAMES)} (default: the file's "
+                             f"setting, as Cycles: sobol)")
 
 
-def _check_integrator_options(integrators, depth, branching, engine=None) -> None:
+def _check_integrator_options(integrators, depth, branching, engine=None, sampler=None) -> None:
     """One-line errors for options that the chosen integrators would ignore."""
-    if engine == ENGINES["cycles"] and (integrators or depth or branching):
-        raise CliError("--integrator, --depth and --branching choose MC Engine's algorithm; "
-                       "they do not apply to --engine cycles")
+    if engine == ENGINES["cycles"] and (integrators or depth or branching or sampler):
+        raise CliError("--integrator, --depth, --branching and --sampler choose MC Engine's "
+                       "algorithm; they do not apply to --engine cycles")
     if not integrators:
         return
-    for option, value in (("depth", depth), ("branching", branching)):
+    for option, value in (("depth", depth), ("branching", branching), ("sampler", sampler)):
         readers = _readers(option)
         if value is not None and not set(readers) & set(integrators):
             plural = "s" if len(readers) > 1 else ""
@@ -472,6 +485,7 @@ class RenderRequest:
     integrator: str | None = None
     depth: int | None = None
     branching: int | None = None
+    sampler: str | None = None
     keep_partial: bool = False
     # -f, -a, -s, -e, -j in order (frames.plan_frames); empty: the file's current frame.
     frame_actions: tuple = ()
@@ -694,12 +708,13 @@ class StudyRequest:
     scene: str | None
     threads: int | None
     verbose: bool
+    sampler: str | None = None
 
 
 def _study_request(args) -> StudyRequest:
     blendfile = Path(args.blendfile).absolute()
     check_blend_file(blendfile)
-    _check_integrator_options(args.integrators, args.depth, args.branching)
+    _check_integrator_options(args.integrators, args.depth, args.branching, sampler=args.sampler)
     if args.reference_samples is not None and args.reference_samples < max(
             2 * args.max_samples, REFERENCE_RENDERS):
         raise CliError(f"--reference-samples {args.reference_samples} is too few to measure "
@@ -712,7 +727,7 @@ def _study_request(args) -> StudyRequest:
         integrators=args.integrators, with_cycles=args.with_cycles, seeds=args.seeds,
         resolution=args.resolution, target=args.target,
         reference_samples=args.reference_samples, depth=args.depth, branching=args.branching,
-        scene=args.scene, threads=args.threads, verbose=args.verbose)
+        scene=args.scene, threads=args.threads, verbose=args.verbose, sampler=args.sampler)
 
 
 def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest | None:
@@ -734,7 +749,7 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest
         return _study_request(args)
     engine = args.engine or DEFAULT_ENGINE
     _check_integrator_options((args.integrator,) if args.integrator else (), args.depth,
-                              args.branching, engine)
+                              args.branching, engine, args.sampler)
     if args.keep_partial and engine != DEFAULT_ENGINE:
         raise CliError("--keep-partial applies to MC Engine renders only (a Cycles render "
                        "cannot be stopped part-way from Python)")
@@ -764,8 +779,8 @@ def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest
         samples=args.samples, resolution=args.resolution, seed=args.seed,
         scene=args.scene, threads=args.threads, verbose=args.verbose,
         integrator=args.integrator, depth=args.depth, branching=args.branching,
-        keep_partial=args.keep_partial, frame_actions=actions, overwrite=args.overwrite,
-        placeholders=args.placeholders)
+        sampler=args.sampler, keep_partial=args.keep_partial, frame_actions=actions,
+        overwrite=args.overwrite, placeholders=args.placeholders)
 
 
 def _check_frame_actions(actions, args) -> None:

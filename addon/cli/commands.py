@@ -265,7 +265,7 @@ def run_render(request: RenderRequest) -> int:
                         resolution=request.resolution, threads=request.threads,
                         integrator=request.integrator, depth=request.depth,
                         branching=request.branching, overwrite=request.overwrite,
-                        placeholders=request.placeholders)
+                        placeholders=request.placeholders, sampler=request.sampler)
     frames = _frames(scene, request, log.console)
     paths = {frame: [frame_path(output.pattern, frame) for output in request.outputs]
              for frame in frames}
@@ -446,7 +446,8 @@ def run_study(request: StudyRequest) -> int:
                            reference_samples=request.reference_samples,
                            target_relmse=request.target)
     settings = StudySettings(resolution=request.resolution, depth=request.depth,
-                             branching=request.branching, threads=request.threads)
+                             branching=request.branching, threads=request.threads,
+                             sampler=request.sampler)
     try:
         with log.capture():
             study = study_file(request.blendfile, options, settings, scene_name=request.scene,

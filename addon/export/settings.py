@@ -9,10 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from mcengine import integrators
+from mcengine import integrators, samplers
 from mcengine.scene import Integrator
 
-__all__ = ["unit_scale", "cycles_settings", "export_integrator", "hash_uint2"]
+from ..properties import SAMPLER_AS_CYCLES
+
+__all__ = ["unit_scale", "cycles_settings", "export_integrator", "export_sampler", "sampler_for",
+           "hash_uint2"]
 
 _MASK32 = 0xFFFFFFFF
 # Cycles hashes (frame_subframe * INT_MAX) as an int when the subframe is non-zero.
@@ -98,8 +101,31 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
         use_adaptive_sampling=bool(cycles.use_adaptive_sampling),
         adaptive_threshold=float(cycles.adaptive_threshold),
         adaptive_min_samples=int(cycles.adaptive_min_samples),
+        sampler=export_sampler(ctx, scene, cycles),
         **mcengine_settings(scene),
     )
+
+
+def export_sampler(ctx, scene, cycles) -> str:
+    """The sampler's name (:func:`sampler_for`); a Cycles pattern not known here is warned
+    and rendered with the default sampler."""
+    info = sampler_for(scene, cycles)
+    if info is None:
+        info = samplers.get(samplers.DEFAULT)
+        ctx.warn(f"Cycles' sampling pattern {cycles.sampling_pattern!r} is not known to MC "
+                 f"Engine; rendering with the {info.label} sampler", "sampling pattern")
+    return info.name
+
+
+def sampler_for(scene, cycles):
+    """MC Engine's own sampler choice, or with "As Cycles" (the default) the one matching
+    Cycles' sampling pattern: scrambled Sobol for each of Cycles' patterns (the blue-noise
+    ones also spread the noise across pixels as blue noise, which MC Engine does not: its
+    pixels are scrambled independently).  None for a pattern not known here."""
+    own = getattr(scene, "mcengine", None)
+    if own is not None and own.sampler != SAMPLER_AS_CYCLES:
+        return samplers.from_enum(own.sampler)
+    return samplers.from_cycles_pattern(str(cycles.sampling_pattern))
 
 
 def mcengine_settings(scene) -> dict:

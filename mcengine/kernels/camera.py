@@ -35,22 +35,22 @@ import numpy as np
 from ..jit import device, kernel
 from .intersect import T_INFINITE
 from .sampling import (
-    DIM_FILTER_X,
-    DIM_FILTER_Y,
-    DIM_LENS_U,
-    DIM_LENS_V,
+    SET_FILTER,
+    SET_LENS_TIME,
     disk_concentric,
     filter_offset,
-    path_key,
-    rand,
     regular_polygon,
+    sample_2d,
+    sample_key,
 )
 from .state import (
     CFG_FULL_W,
     CFG_REGION_W,
     CFG_REGION_X,
     CFG_REGION_Y,
+    CFG_SAMPLER,
     CFG_SEED,
+    CFG_SOBOL_MASK,
     PF_CAMERA,
     PF_MIS_SKIP,
     PF_TRANSPARENT_BG,
@@ -229,11 +229,13 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
 
     The sample index of a path is the pixel's count of finished samples
     (``sample_base``) plus its rank here, so every sample of a pixel has its
-    own random numbers whatever the pass schedule.
+    own random numbers whatever the pass schedule (and a pixel's Sobol points go on
+    from where its earlier passes stopped).
     """
     n = 0
     region_x, region_y, region_w = cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W]
     lens = sc.camera[C_APERTURE] > 0.0
+    sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
     for pi in range(pixels.shape[0]):
         pix = pixels[pi]
         x = region_x + pix % region_w
@@ -241,17 +243,17 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
         global_pixel = y * cfg[CFG_FULL_W] + x
         for j in range(spp):
             sample = sample_base[pix] + j
-            key = path_key(cfg[CFG_SEED], global_pixel, sample)
+            key = sample_key(sampler, cfg[CFG_SEED], global_pixel, sample)
             # Cycles takes the first sample of every pixel at the pixel centre.
             if sample == 0:
                 fx, fy = 0.5, 0.5
             else:
-                fx = filter_offset(sc.filter_table, rand(key, DIM_FILTER_X))
-                fy = filter_offset(sc.filter_table, rand(key, DIM_FILTER_Y))
+                ux, uy = sample_2d(sampler, key, SET_FILTER, mask)
+                fx = filter_offset(sc.filter_table, ux)
+                fy = filter_offset(sc.filter_table, uy)
             lu = lv = 0.0
             if lens:
-                lu = rand(key, DIM_LENS_U)
-                lv = rand(key, DIM_LENS_V)
+                lu, lv = sample_2d(sampler, key, SET_LENS_TIME, mask)
             ox, oy, oz, dx, dy, dz, tmax = camera_ray(sc.camera, x + fx, y + fy, lu, lv)
             st.key[n] = key
             st.pixel[n] = pix

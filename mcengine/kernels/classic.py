@@ -22,6 +22,9 @@ They differ from path tracing in how rays branch at a surface hit:
 triangles as a group (picked by power).  The depth counts ray levels, the
 camera ray being level 1, as in the lecture.
 
+Random numbers are independent (``sampling.SAMPLER_INDEPENDENT``): a child ray's key
+is a hash of its parent's, so no two rays of a tree share numbers.
+
 Wavefront execution: each generation of rays is one Embree call; the
 shading kernel writes the next generation into a second buffer.  A chunk
 holds few enough camera samples that its widest generation fits the batch.
@@ -54,17 +57,7 @@ from .closures.microfacet import microfacet_fresnel
 from .intersect import offset_origin
 from .light_sampling import PMF_EVERY, pick_light
 from .lights import L_PMF
-from .sampling import (
-    DIM_BSDF_LOBE,
-    DIM_BSDF_U,
-    DIM_BSDF_V,
-    DIM_BSDF_W,
-    DIM_LIGHT_PICK,
-    DIM_LIGHT_U,
-    DIM_LIGHT_V,
-    mix64,
-    rand,
-)
+from .sampling import SAMPLER_INDEPENDENT, SET_BSDF, SET_LIGHT, mix64, sample_4d
 from .shading import (
     direct_light,
     leaves_correct_side,
@@ -101,6 +94,7 @@ CODE_DISTRIBUTION = 3
 WHITTED_RAYS = {K_PRINCIPLED: 6, K_GLOSSY: 1, K_GLASS: 2, K_REFRACTION: 1, K_TRANSPARENT: 1}
 _K_CHILD = np.uint64(0xA24BAED4963EE407)
 _K_LIGHT = np.uint64(0x9FB21C651E98DF25)
+_NO_MASK = np.uint64(0)          # the independent sampler has no Sobol index to mask
 
 
 @device
@@ -220,13 +214,14 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                     idx = li
                     pmf = 1.0
                 else:
-                    j = pick_light(sc.emit_cdf, rand(key, DIM_LIGHT_PICK))
+                    _, _, u_pick, _ = sample_4d(SAMPLER_INDEPENDENT, key, SET_LIGHT, _NO_MASK)
+                    j = pick_light(sc.emit_cdf, u_pick)
                     idx = n_lamps + j
                     pmf = sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
+                lu, lv, _, _ = sample_4d(SAMPLER_INDEPENDENT, lkey, SET_LIGHT, _NO_MASK)
                 n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
-                                        scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce,
-                                        rand(lkey, DIM_LIGHT_U), rand(lkey, DIM_LIGHT_V),
+                                        scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
                                         nee_mis, float(branching),
                                         cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
         if not spawn:
@@ -237,9 +232,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
             k = 1.0 / branching
             for c in range(branching):
                 ckey = mix64(key ^ (np.uint64(c + 1) * _K_CHILD))
-                ds = sample_direction(cl, ncl, sp, dx, dy, dz, rand(ckey, DIM_BSDF_LOBE),
-                                      rand(ckey, DIM_BSDF_U), rand(ckey, DIM_BSDF_V),
-                                      rand(ckey, DIM_BSDF_W))
+                bu, bv, u_lobe, bw = sample_4d(SAMPLER_INDEPENDENT, ckey, SET_BSDF, _NO_MASK)
+                ds = sample_direction(cl, ncl, sp, dx, dy, dz, u_lobe, bu, bv, bw)
                 if not ds.ok:
                     continue
                 n_next = _push_child(nx, n_next, st, i, ckey, sp, ds.wix, ds.wiy, ds.wiz,

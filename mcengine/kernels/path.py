@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..jit import device, kernel
 from .camera import generate_camera_rays
 from .closures.layout import (
@@ -43,19 +45,7 @@ from .closures.layout import (
 )
 from .intersect import offset_origin
 from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
-from .sampling import (
-    DIM_BSDF_LOBE,
-    DIM_BSDF_U,
-    DIM_BSDF_V,
-    DIM_BSDF_W,
-    DIM_LIGHT_GROUP,
-    DIM_LIGHT_PICK,
-    DIM_LIGHT_U,
-    DIM_LIGHT_V,
-    DIM_ROULETTE,
-    bounce_dim,
-    rand,
-)
+from .sampling import SET_BSDF, SET_LIGHT, SET_TERMINATE, bounce_set, sample_1d, sample_4d
 from .shading import (
     direct_light,
     light_from_background,
@@ -79,6 +69,8 @@ from .state import (
     CFG_MAX_TRANSPARENT,
     CFG_MIN_LIGHT_BOUNCES,
     CFG_MIS,
+    CFG_SAMPLER,
+    CFG_SOBOL_MASK,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     MF_EMISSIVE,
@@ -107,6 +99,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
     pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
     has_group = sc.emit_tri.shape[0] > 0
     max_transparent = cfg[CFG_MAX_TRANSPARENT]
+    sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
@@ -180,7 +173,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         if bounce > cfg[CFG_MIN_LIGHT_BOUNCES] + 1:
             q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
             if q < 1.0:
-                if rand(key, bounce_dim(vertex, DIM_ROULETTE)) >= q:
+                if sample_1d(sampler, key, bounce_set(vertex, SET_TERMINATE), mask) >= q:
                     continue
                 st.beta[i, 0] /= q
                 st.beta[i, 1] /= q
@@ -188,29 +181,24 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
 
         # -- next-event estimation: one light --------------------------------------------------
         if nee:
-            u_pick = rand(key, bounce_dim(vertex, DIM_LIGHT_PICK))
+            lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
             if local:
                 idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, sp.hx, sp.hy, sp.hz,
                                             u_pick)
                 if idx == n_lamps:
-                    j = pick_light(sc.emit_cdf, rand(key, bounce_dim(vertex, DIM_LIGHT_GROUP)))
+                    j = pick_light(sc.emit_cdf, u_group)
                     idx = n_lamps + j
                     pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
             n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
-                                    scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce,
-                                    rand(key, bounce_dim(vertex, DIM_LIGHT_U)),
-                                    rand(key, bounce_dim(vertex, DIM_LIGHT_V)), True, 1.0,
-                                    max_transparent - st.transparent[i])
+                                    scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
+                                    True, 1.0, max_transparent - st.transparent[i])
 
         # -- BSDF sampling: the next ray ---------------------------------------------------------
-        ds = sample_direction(scratch.cl, ncl, sp, dx, dy, dz,
-                              rand(key, bounce_dim(vertex, DIM_BSDF_LOBE)),
-                              rand(key, bounce_dim(vertex, DIM_BSDF_U)),
-                              rand(key, bounce_dim(vertex, DIM_BSDF_V)),
-                              rand(key, bounce_dim(vertex, DIM_BSDF_W)))
+        bu, bv, u_lobe, bw = sample_4d(sampler, key, bounce_set(vertex, SET_BSDF), mask)
+        ds = sample_direction(scratch.cl, ncl, sp, dx, dy, dz, u_lobe, bu, bv, bw)
         if not ds.ok:
             continue
         st.beta[i, 0] *= ds.wr

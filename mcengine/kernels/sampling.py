@@ -1,7 +1,16 @@
 """Samplers and warps: random numbers and the maps from [0,1)^2 to shapes.
 
-Random numbers are counter-based: ``rand(key, dim)`` hashes a 64-bit path key
-(made from the seed, the pixel and the sample index) with a dimension number.
+Random numbers are counter-based: a path carries a 64-bit key made from the
+seed, the pixel and the sample index, and ``sample_1d/2d/4d`` turn the key
+and a *dimension set* into numbers.  Two samplers exist:
+
+* the independent sampler: ``rand(key, dim)`` hashes the key with a dimension
+  number, so every number is independent of every other (the lecture's
+  sampler: the error of N samples falls exactly as 1/sqrt(N));
+* the Sobol sampler (``sobol``): each pixel's samples are Owen-scrambled,
+  shuffled Sobol points, stratified within each dimension set, as Cycles
+  samples; unbiased, and its error falls faster for smooth integrands.
+
 The same (seed, pixel, sample, dimension) always gives the same number, in any
 thread and any batch, which makes renders reproducible and lets tests compare
 the wavefront kernels with scalar code.
@@ -18,33 +27,39 @@ import math
 import numpy as np
 
 from ..jit import device
+from .sobol import INDEX_BITS, reversed_index, shuffled_index, sobol_1d, sobol_2d, sobol_4d
 
-# -- dimensions ----------------------------------------------------------------
-# Camera dimensions come first, then a block of DIMS_PER_BOUNCE numbers for
-# every path vertex, so adding a use of randomness never shifts another one.
-DIM_FILTER_X = 0
-DIM_FILTER_Y = 1
-DIM_LENS_U = 2
-DIM_LENS_V = 3
-DIM_TIME = 4
-DIM_BOUNCE_BASE = 8
-DIMS_PER_BOUNCE = 16
-DIM_LIGHT_PICK = 0       # which light to sample
-DIM_LIGHT_U = 1          # point on the light
-DIM_LIGHT_V = 2
-DIM_BSDF_LOBE = 3        # which BSDF lobe
-DIM_BSDF_U = 4           # direction from the lobe
-DIM_BSDF_V = 5
-DIM_ROULETTE = 6         # Russian roulette
-DIM_LIGHT_GROUP = 7      # which emissive triangle, once the group is picked
-DIM_BSDF_W = 8           # third number of a BSDF sample (reflection or refraction)
+# -- samplers and dimensions ------------------------------------------------------
+# Which numbers a path draws (``sample_key`` and ``sample_1d/2d/4d``):
+SAMPLER_INDEPENDENT = 0   # every number an independent hash (the lecture's sampler)
+SAMPLER_SOBOL = 1         # Owen-scrambled, shuffled Sobol points per pixel (``sobol``)
+
+# Numbers come in *dimension sets* of up to four, as Cycles assigns them
+# (kernel/types.h, PRNG_*): the camera's sets first, then SETS_PER_BOUNCE sets
+# for every path vertex (scattering or transparent), so adding a use of
+# randomness never shifts another one.  With the Sobol sampler the numbers of
+# one set are stratified together (put the most important pair first) and
+# different sets are independent; the independent sampler draws number k of
+# set s as dimension 4 s + k.
+SET_FILTER = 0           # 2: pixel filter x, y
+SET_LENS_TIME = 1        # 3: lens u, v and shutter time (reserved)
+SETS_PER_BOUNCE = 16
+SET_TERMINATE = 0        # 1: Russian roulette
+SET_LIGHT = 1            # 4: point on the light u, v; which light; which emissive triangle
+SET_BSDF = 3             # 4: direction u, v; which closure; the lobe's third number
+
+SAMPLE_BITS = INDEX_BITS   # sample index bits of a Sobol path key (Cycles' limit, 2^24 samples)
+_SAMPLE_MASK = np.uint64((1 << SAMPLE_BITS) - 1)
 
 _K_PIXEL = np.uint64(0x9E3779B97F4A7C15)    # golden-ratio increment (Weyl sequence)
 _K_SAMPLE = np.uint64(0xD1B54A32D192ED03)
 _K_DIM = np.uint64(0xAEF17502108EF2D9)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)         # splitmix64 finaliser constants
 _M2 = np.uint64(0x94D049BB133111EB)
+_M32 = np.uint64(0xFFFFFFFF)
 _INV_2_53 = 1.0 / 9007199254740992.0
+_K_SEED_B = np.uint64(0x5851F42D4C957F2D)   # any odd 64-bit constants
+_K_SEED_C = np.uint64(0x14057B7EF767814F)
 
 
 @device
@@ -71,8 +86,60 @@ def rand(key, dim):
 
 
 @device
-def bounce_dim(bounce, which):
-    return DIM_BOUNCE_BASE + bounce * DIMS_PER_BOUNCE + which
+def bounce_set(vertex, which):
+    """Dimension set ``which`` (SET_TERMINATE, ...) of path vertex ``vertex`` (0: first hit)."""
+    return SETS_PER_BOUNCE * (vertex + 1) + which
+
+
+@device
+def sample_key(sampler, seed, pixel, sample):
+    """The key a path carries.  Independent: a hash of (seed, pixel, sample).  Sobol: a
+    hash of (seed, pixel) in the high bits, the bit-reversed sample index in the low
+    SAMPLE_BITS."""
+    if sampler == SAMPLER_SOBOL:
+        return (path_key(seed, pixel, 0) & ~_SAMPLE_MASK) | reversed_index(sample)
+    return path_key(seed, pixel, sample)
+
+
+@device
+def _set_seeds(key, dim_set):
+    """Five 32-bit scrambling seeds of a Sobol key's pixel and a dimension set: the index
+    shuffle's, then one per dimension.  Each is hashed on its own: seeds that differ by
+    fixed bits (one hash XORed with constants) correlate the dimensions' scrambles and
+    bias the estimates (tests/core/test_sobol.py finds it)."""
+    h = (key >> np.uint64(SAMPLE_BITS)) ^ (np.uint64(dim_set + 1) * _K_DIM)
+    a = mix64(h)
+    b = mix64(h ^ _K_SEED_B)     # three hashes of one input, computed side by side
+    c = mix64(h ^ _K_SEED_C)
+    return a & _M32, a >> np.uint64(32), b & _M32, b >> np.uint64(32), c & _M32
+
+
+@device
+def sample_1d(sampler, key, dim_set, mask):
+    """The first number of dimension set ``dim_set``; ``mask`` is the Sobol index mask."""
+    if sampler == SAMPLER_SOBOL:
+        s, s0, _, _, _ = _set_seeds(key, dim_set)
+        return sobol_1d(shuffled_index(key & _SAMPLE_MASK, s, mask), s0)
+    return rand(key, 4 * dim_set)
+
+
+@device
+def sample_2d(sampler, key, dim_set, mask):
+    """The first two numbers of dimension set ``dim_set`` (stratified together with Sobol)."""
+    if sampler == SAMPLER_SOBOL:
+        s, s0, s1, _, _ = _set_seeds(key, dim_set)
+        return sobol_2d(shuffled_index(key & _SAMPLE_MASK, s, mask), s0, s1)
+    return rand(key, 4 * dim_set), rand(key, 4 * dim_set + 1)
+
+
+@device
+def sample_4d(sampler, key, dim_set, mask):
+    """The four numbers of dimension set ``dim_set``."""
+    if sampler == SAMPLER_SOBOL:
+        s, s0, s1, s2, s3 = _set_seeds(key, dim_set)
+        return sobol_4d(shuffled_index(key & _SAMPLE_MASK, s, mask), s0, s1, s2, s3)
+    d = 4 * dim_set
+    return rand(key, d), rand(key, d + 1), rand(key, d + 2), rand(key, d + 3)
 
 
 # -- warps -----------------------------------------------------------------------

@@ -123,7 +123,9 @@ CFG_CAUSTICS_REFRACTIVE = 18
 CFG_TRANSPARENT_SHADOWS = 19   # some material lets shadow rays through: trace them hit by hit
 CFG_MIS = 20              # emission found by rays gets MIS weights (some light is sampled and hit)
 CFG_CAUSTICS = 21         # caustic paths: Filter Glossy and the caustics switches apply
-CFG_SIZE = 22
+CFG_SAMPLER = 22          # sampling.SAMPLER_*: which numbers paths draw
+CFG_SOBOL_MASK = 23       # mask of the Sobol sampler's shuffled sample index (sobol.index_mask)
+CFG_SIZE = 24
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1

@@ -31,6 +31,30 @@ def test_adaptive_sampling_and_integrator_choice(scene, fake_session):
     assert (i.name, i.depth, i.branching) == ("distribution", 3, 6)
 
 
+@pytest.mark.parametrize("pattern", ["AUTOMATIC", "TABULATED_SOBOL", "BLUE_NOISE"])
+def test_sampler_follows_cycles_pattern_unless_chosen(scene, fake_session, pattern):
+    """"As Cycles" (the default) exports the sampler of Cycles' pattern: scrambled Sobol
+    for every pattern Blender offers; MC Engine's own choice wins over it."""
+    assert scene.mcengine.sampler == "AUTOMATIC"
+    scene.cycles.sampling_pattern = pattern
+    assert export_scene(fake_session).integrator.sampler == "sobol"
+    scene.mcengine.sampler = "INDEPENDENT"
+    assert export_scene(fake_session).integrator.sampler == "independent"
+    scene.mcengine.sampler = "SOBOL"
+    assert export_scene(fake_session).integrator.sampler == "sobol"
+
+
+def test_unknown_cycles_pattern_is_warned(scene, fake_session, monkeypatch):
+    from mcengine import samplers
+    monkeypatch.delitem(samplers.CYCLES_PATTERNS, "BLUE_NOISE")   # a pattern we do not know
+    scene.cycles.sampling_pattern = "BLUE_NOISE"
+    scene.cycles.use_denoising = False
+    desc = export_scene(fake_session)
+    assert desc.integrator.sampler == "sobol"
+    assert desc.warnings == ["Cycles' sampling pattern 'BLUE_NOISE' is not known to MC Engine; "
+                             "rendering with the Scrambled Sobol sampler"]
+
+
 def test_view_layer_samples_override(scene, fake_session):
     scene.cycles.samples = 64
     bpy.context.view_layer.samples = 5

@@ -74,8 +74,9 @@ def test_study_needs_a_camera(scene):
 
 
 @pytest.mark.parametrize("integrator, drawn", [
-    ("PATH", ["integrator"]), ("RAYCAST", ["integrator"]),
-    ("WHITTED", ["integrator", "depth"]), ("DISTRIBUTION", ["integrator", "depth", "branching"]),
+    ("PATH", ["integrator", "sampler"]), ("RAYCAST", ["integrator", "sampler"]),
+    ("WHITTED", ["integrator", "sampler", "depth"]),
+    ("DISTRIBUTION", ["integrator", "sampler", "depth", "branching"]),
 ])
 def test_panel_draws_the_integrator_settings_that_apply(addon, scene, integrator, drawn):
     scene.mcengine.integrator = integrator

@@ -71,6 +71,13 @@ def run_cli(*args) -> subprocess.CompletedProcess:
     (["render", "{cube}", "--integrator", "whitted", "--branching", "4"], "--branching applies to"),
     (["render", "{cube}", "--engine", "cycles", "--integrator", "raycast"],
      "do not apply to --engine cycles"),
+    (["render", "{cube}", "--sampler", "halton"], "unknown sampler 'halton'"),
+    (["render", "{cube}", "--integrator", "whitted", "--sampler", "sobol"],
+     "--sampler applies to the path integrator only"),
+    (["render", "{cube}", "--engine", "cycles", "--sampler", "independent"],
+     "do not apply to --engine cycles"),
+    (["study", "{cube}", "--integrators", "raycast", "--sampler", "independent"],
+     "--sampler applies to the path integrator only"),
 ])
 def test_bad_options_are_one_line_before_blender_starts(args, fragment, scenes, capsys):
     args = [a.format(cube=scenes / "cube.blend", missing=scenes / "missing.blend") for a in args]
@@ -94,7 +101,7 @@ def test_study_writes_one_row_per_render_and_the_report(scenes, tmp_path):
     out = tmp_path / "study"
     done = run_cli("study", scenes / "cube.blend", "--max-samples", "2", "--seeds", "2",
                    "--resolution", "16x12", "--integrators", "path,raycast", "--with-cycles",
-                   "--out", out)
+                   "--sampler", "independent", "--out", out)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [str(out / "study.html")]
     with open(out / "study.csv", newline="") as f:
@@ -109,6 +116,7 @@ def test_study_writes_one_row_per_render_and_the_report(scenes, tmp_path):
     for name in ("error_vs_time.png", "error_vs_samples.png", "equal_time.png", "study.md",
                  "study.json"):
         assert (out / name).is_file(), name
+    assert "| Path tracing (Independent sampler) |" in (out / "study.md").read_text()
     # one line per render (4 + 4 references, 1 warm-up, 12 ladder renders), one per integrator
     assert "mcengine: [21/21] cycles 2 samples, seed 1002" in done.stderr
     assert "mcengine: raycast: " in done.stderr and "Traceback" not in done.stderr

@@ -136,12 +136,20 @@ def _engine(text: str) -> str:
     return idname
 
 
-def _integrator(text: str) -> str:
-    name = text.lower()
-    if name not in INTEGRATORS:
-        raise argparse.ArgumentTypeError(
-            f"unknown integrator {text!r} (choose from {', '.join(INTEGRATOR_NAMES)})")
-    return name
+def _one_of(kind: str, names):
+    """An argparse type: ``names``' member that the text names (any case); an unknown one
+    is a one-line error listing the choices."""
+    def parse(text: str) -> str:
+        name = text.lower()
+        if name not in names:
+            raise argparse.ArgumentTypeError(
+                f"unknown {kind} {text!r} (choose from {', '.join(names)})")
+        return name
+    return parse
+
+
+_integrator = _one_of("integrator", INTEGRATOR_NAMES)
+_sampler = _one_of("sampler", SAMPLER_NAMES)
 
 
 def _integrator_list(text: str) -> tuple[str, ...]:
@@ -151,14 +159,6 @@ def _integrator_list(text: str) -> tuple[str, ...]:
     if len(set(names)) != len(names):
         raise argparse.ArgumentTypeError(f"an integrator is listed twice in {text!r}")
     return names
-
-
-def _sampler(text: str) -> str:
-    name = text.lower()
-    if name not in SAMPLER_NAMES:
-        raise argparse.ArgumentTypeError(
-            f"unknown sampler {text!r} (choose from {', '.join(SAMPLER_NAMES)})")
-    return name
 
 
 def _depth(text: str) -> int:

@@ -3,7 +3,8 @@
 One :class:`GraphReader` copies what one output socket (a material's Surface,
 a world's Surface) receives, as Cycles reads it (blender/shader.cpp):
 
-* links are followed through reroutes; muted links are dropped; muted nodes
+* links are followed through reroutes; muted links, invalid ones and those from or to
+  a hidden socket are dropped; muted nodes
   pass their input through along their internal links, as in Blender;
 * node groups are flattened: a group node's output leads into the group's
   active Group Output, a Group Input back out to the group node's input (or
@@ -97,7 +98,7 @@ class GraphReader:
         """What an input socket receives: (output socket, group path) of a real node, or
         (None, value) with the constant it gets (None: nothing at all)."""
         for _ in range(1024):
-            links = [link for link in socket.links if not link.is_muted] if socket.is_linked else []
+            links = [link for link in socket.links if _carries(link)] if socket.is_linked else []
             if not links:
                 value = getattr(socket, "default_value", None)
                 return None, value
@@ -229,6 +230,13 @@ class GraphReader:
                       f"{label(node)} rendered as 0.8 grey diffuse")
             return ShaderNode("BsdfDiffuse", {"Color": DEFAULT_GREY}, name=node.name)
         return ShaderNode(kind, {}, name=node.name)
+
+
+def _carries(link) -> bool:
+    """Whether a link carries a value: Cycles drops muted and invalid links and those from or
+    to a socket the node hides (Vector Math's Value output for a vector operation, ...)."""
+    return (not link.is_muted and link.is_valid and link.from_socket.enabled
+            and link.to_socket.enabled)
 
 
 def _constant(value, kind):

@@ -30,6 +30,7 @@ from collections import namedtuple
 
 from ...jit import device, function
 from .closure_nodes import eval_closure_node
+from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ATTR_DEFAULT_UV,
     OBJ_COLOR,
@@ -44,8 +45,10 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     TextureData,
 )
 from .input_nodes import eval_input_node
-from .nodes import FAMILY_INPUT, FAMILY_TEXTURE
+from .math_nodes import eval_math_node
+from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_TEXTURE, FAMILY_VECTOR
 from .texture_nodes import eval_texture_node
+from .vector_nodes import eval_vector_node
 
 OP_END = 0
 OP_NODE = 1
@@ -59,9 +62,6 @@ MAX_REGS = 1 << 22            # registers of all materials together (32 MiB per 
 CONV_COLOR_TO_FLOAT = 0       # luminance: dot(c, RGB_TO_Y)
 CONV_VECTOR_TO_FLOAT = 1      # mean of the components
 CONV_FLOAT_TO_VECTOR = 2      # (f, f, f), also to a colour
-# Luminance of the working space (Linear Rec.709): the Y row of its RGB -> XYZ matrix, as
-# Cycles' rgb_to_y reads it from Blender's OCIO configuration.
-RGB_TO_Y = (0.212639, 0.715169, 0.072193)
 
 ShaderResult = namedtuple("ShaderResult", [
     "n",                       # closures written to cl
@@ -77,15 +77,19 @@ def eval_node(code, regs, b, c, sd, tex):
     family = code // 100
     if family == FAMILY_INPUT:
         eval_input_node(code, regs, b, c, sd, tex)
+    elif family == FAMILY_MATH:
+        eval_math_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_TEXTURE:
         eval_texture_node(code, regs, b, c, sd, tex)
+    elif family == FAMILY_VECTOR:
+        eval_vector_node(code, regs, b, c, sd, tex)
 
 
 @device
 def convert(regs, a, b, kind):
     """OP_CONVERT: regs[a:] = regs[b:] converted (``CONV_*``)."""
     if kind == CONV_COLOR_TO_FLOAT:
-        regs[a] = RGB_TO_Y[0] * regs[b] + RGB_TO_Y[1] * regs[b + 1] + RGB_TO_Y[2] * regs[b + 2]
+        regs[a] = luminance(regs[b], regs[b + 1], regs[b + 2])
     elif kind == CONV_VECTOR_TO_FLOAT:
         regs[a] = (regs[b] + regs[b + 1] + regs[b + 2]) * (1.0 / 3.0)
     else:

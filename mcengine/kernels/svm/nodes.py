@@ -52,8 +52,37 @@ DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_
 
 # Enum properties: property name -> {Blender's identifier: code}.  A node's enum inputs
 # ("prop:<name>") are encoded with the table of that name.
+# Operations of the Math and Vector Math nodes (one ``operation`` property, one table: the
+# identifiers both nodes share have one code).  Cycles' NodeMathType / NodeVectorMathType.
+OPERATIONS = {name: k for k, name in enumerate((
+    "ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT",
+    "INVERSE_SQRT", "ABSOLUTE", "EXPONENT", "MINIMUM", "MAXIMUM", "LESS_THAN", "GREATER_THAN",
+    "SIGN", "COMPARE", "SMOOTH_MIN", "SMOOTH_MAX", "ROUND", "FLOOR", "CEIL", "TRUNC", "FRACT",
+    "MODULO", "FLOORED_MODULO", "WRAP", "SNAP", "PINGPONG", "SINE", "COSINE", "TANGENT",
+    "ARCSINE", "ARCCOSINE", "ARCTANGENT", "ARCTAN2", "SINH", "COSH", "TANH", "RADIANS",
+    "DEGREES",
+    # Vector Math only
+    "CROSS_PRODUCT", "PROJECT", "REFLECT", "REFRACT", "FACEFORWARD", "DOT_PRODUCT", "DISTANCE",
+    "LENGTH", "SCALE", "NORMALIZE", "FRACTION"))}
+# Map Range's interpolation.
+MAP_RANGE_INTERPOLATIONS = {"LINEAR": 0, "STEPPED": 1, "SMOOTHSTEP": 2, "SMOOTHERSTEP": 3}
+# ``data_type``: which sockets are in use (Map Range: FLOAT, FLOAT_VECTOR; Mix: FLOAT, VECTOR,
+# RGBA).  Tables are per property name, so nodes sharing a property name share its table.
+DATA_TYPES = {"FLOAT": 0, "FLOAT_VECTOR": 1, "VECTOR": 2, "RGBA": 3}
+CLAMP_TYPES = {"MINMAX": 0, "RANGE": 1}
+# Separate / Combine Color: the colour model of the three channels.
+COLOR_MODES = {"RGB": 0, "HSV": 1, "HSL": 2}
+# ``vector_type``: Mapping (all four), Vector Transform (POINT, VECTOR, NORMAL).
+VECTOR_TYPES = {"POINT": 0, "TEXTURE": 1, "VECTOR": 2, "NORMAL": 3}
+
 ENUMS = {
     "distribution": DISTRIBUTIONS,
+    "operation": OPERATIONS,
+    "interpolation_type": MAP_RANGE_INTERPOLATIONS,
+    "data_type": DATA_TYPES,
+    "clamp_type": CLAMP_TYPES,
+    "mode": COLOR_MODES,
+    "vector_type": VECTOR_TYPES,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -152,10 +181,37 @@ VALUE_NODES = {
                                       _v("True Normal"), _v("Incoming"), _v("Parametric"),
                                       _f("Backfacing", 0.0), _f("Pointiness", 0.0),
                                       _f("Random Per Island", 0.0)), False),
+    # -- math family: converters (svm/math_nodes.py)
+    "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
+                           _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),
+                     (_f("Value", 0.0),), True),
+    "VectorMath": NodeSpec(202, (_v("Vector"), _v("Vector_001"), _v("Vector_002"), _f("Scale", 1.0),
+                                 _p("operation", OPERATIONS["ADD"])),
+                           (_v("Vector"), _f("Value", 0.0)), True),
+    "MapRange": NodeSpec(203, (
+        _f("Value", 1.0), _f("From Min", 0.0), _f("From Max", 1.0), _f("To Min", 0.0),
+        _f("To Max", 1.0), _f("Steps", 4.0), _v("Vector"), _v("From_Min_FLOAT3", (0, 0, 0)),
+        _v("From_Max_FLOAT3", WHITE), _v("To_Min_FLOAT3", (0, 0, 0)), _v("To_Max_FLOAT3", WHITE),
+        _v("Steps_FLOAT3", (4, 4, 4)), _p("clamp", 1), _p("interpolation_type", 0),
+        _p("data_type", 0)), (_f("Result", 0.0), _v("Vector")), True),
+    "Clamp": NodeSpec(204, (_f("Value", 1.0), _f("Min", 0.0), _f("Max", 1.0), _p("clamp_type", 0)),
+                      (_f("Result", 0.0),), True),
+    "SeparateXYZ": NodeSpec(205, (_v("Vector"),), (_f("X", 0.0), _f("Y", 0.0), _f("Z", 0.0)), True),
+    "CombineXYZ": NodeSpec(206, (_f("X", 0.0), _f("Y", 0.0), _f("Z", 0.0)), (_v("Vector"),), True),
+    "SeparateColor": NodeSpec(207, (_c("Color", GREY), _p("mode", 0)),
+                              (_f("Red", 0.0), _f("Green", 0.0), _f("Blue", 0.0)), True),
+    "CombineColor": NodeSpec(208, (_f("Red", 0.0), _f("Green", 0.0), _f("Blue", 0.0), _p("mode", 0)),
+                             (_c("Color", (0, 0, 0)),), True),
+    "RGBToBW": NodeSpec(209, (_c("Color", (0.5, 0.5, 0.5)),), (_f("Val", 0.0),), True),
+    "Blackbody": NodeSpec(210, (_f("Temperature", 6500.0),), (_c("Color", (0, 0, 0)),), True),
+    "Wavelength": NodeSpec(211, (_f("Wavelength", 500.0),), (_c("Color", (0, 0, 0)),), True),
     # -- texture family
     "TexChecker": NodeSpec(401, (_v("Vector", GENERATED), _c("Color1", (0.8, 0.8, 0.8)),
                                  _c("Color2", (0.2, 0.2, 0.2)), _f("Scale", 5.0)),
                            (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    # -- vector family (svm/vector_nodes.py)
+    "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
+                              _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
 }
 
 NODES = {**CLOSURES, **VALUE_NODES}

@@ -1,0 +1,69 @@
+"""Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h).
+
+``eval_vector_node`` evaluates one node of the family: inputs at regs[b:] in
+the order of ``nodes.VALUE_NODES``, outputs to regs[c:].
+"""
+from __future__ import annotations
+
+import math
+
+from ...jit import device, function
+from .math_nodes import safe_divide, safe_normalize
+from .nodes import NODES, OFFSETS, VECTOR_TYPES
+
+_MAPPING = NODES["Mapping"].code
+_MP_LOCATION = OFFSETS["Mapping"]["Location"]
+_MP_ROTATION = OFFSETS["Mapping"]["Rotation"]
+_MP_SCALE = OFFSETS["Mapping"]["Scale"]
+_MP_TYPE = OFFSETS["Mapping"]["prop:vector_type"]
+_POINT = VECTOR_TYPES["POINT"]
+_TEXTURE = VECTOR_TYPES["TEXTURE"]
+_VECTOR = VECTOR_TYPES["VECTOR"]
+_NORMAL = VECTOR_TYPES["NORMAL"]
+
+
+@function
+def eval_vector_node(code, regs, b, c, sd, tex):
+    if code == _MAPPING:
+        mapping_node(regs, b, c)
+
+
+@device
+def euler_rotation(rx, ry, rz):
+    """Rows of the rotation by Euler angles XYZ (about X first, then Y, then Z)."""
+    cx, cy, cz = math.cos(rx), math.cos(ry), math.cos(rz)
+    sx, sy, sz = math.sin(rx), math.sin(ry), math.sin(rz)
+    return ((cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz),
+            (cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz),
+            (-sy, cy * sx, cy * cx))
+
+
+@device
+def mapping_node(regs, b, c):
+    """Mapping: Point R(v s) + t; Texture R^T(v - t) / s; Vector R(v s); Normal
+    normalize(R(v / s)); divisions by a zero scale component give 0 (svm_mapping)."""
+    kind = int(regs[b + _MP_TYPE])
+    vx, vy, vz = regs[b], regs[b + 1], regs[b + 2]
+    tx, ty, tz = regs[b + _MP_LOCATION], regs[b + _MP_LOCATION + 1], regs[b + _MP_LOCATION + 2]
+    sx, sy, sz = regs[b + _MP_SCALE], regs[b + _MP_SCALE + 1], regs[b + _MP_SCALE + 2]
+    r0, r1, r2 = euler_rotation(regs[b + _MP_ROTATION], regs[b + _MP_ROTATION + 1],
+                                regs[b + _MP_ROTATION + 2])
+    x = y = z = 0.0
+    if kind == _TEXTURE:
+        dx, dy, dz = vx - tx, vy - ty, vz - tz
+        x = safe_divide(r0[0] * dx + r1[0] * dy + r2[0] * dz, sx)
+        y = safe_divide(r0[1] * dx + r1[1] * dy + r2[1] * dz, sy)
+        z = safe_divide(r0[2] * dx + r1[2] * dy + r2[2] * dz, sz)
+    elif kind == _POINT or kind == _VECTOR or kind == _NORMAL:
+        if kind == _NORMAL:
+            px, py, pz = safe_divide(vx, sx), safe_divide(vy, sy), safe_divide(vz, sz)
+        else:
+            px, py, pz = vx * sx, vy * sy, vz * sz
+        x = r0[0] * px + r0[1] * py + r0[2] * pz
+        y = r1[0] * px + r1[1] * py + r1[2] * pz
+        z = r2[0] * px + r2[1] * py + r2[2] * pz
+        if kind == _POINT:
+            x, y, z = x + tx, y + ty, z + tz
+        elif kind == _NORMAL:
+            x, y, z = safe_normalize(x, y, z)
+    regs[c], regs[c + 1], regs[c + 2] = x, y, z

@@ -28,13 +28,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import memory
+from . import accel_cache, memory
 from .adaptive import Adaptive
 from .film import Film
 from .integrators import get as integrator_info
 from .kernels import classic, path
 from .kernels.classic import WHITTED_RAYS
-from .kernels.intersect import Accel
 from .kernels.state import (
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
@@ -223,7 +222,8 @@ class RenderSession:
         self.active = np.arange(self.film.count.size, dtype=np.int32)
         self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
-        self.accel = Accel(scene.geometry.vertices, scene.geometry.triangles)
+        self.accel, self.stats.extra["bvh_reused"] = accel_cache.accel_for(
+            scene.geometry.vertices, scene.geometry.triangles)
         self.stats.time_bvh = time.perf_counter() - t0
         t0 = time.perf_counter()
         self._warm_up()

@@ -30,3 +30,21 @@ def test_f12_renders_with_the_real_core(scene, render_exr):
     assert scene.mcengine.last_effects == (
         "Lights: 2 emissive triangles; surfaces: emission; no textures | simulated: light sampling, "
         "MIS weights | skipped: lamp hits, world lookups, transparent shadows, caustic paths")
+
+
+def test_frames_with_the_same_triangles_reuse_the_bvh(scene, addon):
+    """Animation frames and viewport restarts: the camera moved -> the BVH is reused; the
+    object moved -> it is built again (mcengine.accel_cache)."""
+    scene.render.resolution_x, scene.render.resolution_y = 8, 8
+    scene.cycles.samples = 1
+    card = new_mesh_object("Card", [(-1, -1, -3), (1, -1, -3), (1, 1, -3), (-1, 1, -3)],
+                           [(0, 1, 2, 3)])
+    reused = []
+    for move in (None, "camera", "object", None):
+        if move == "camera":
+            scene.camera.location.x += 0.1
+        elif move == "object":
+            card.location.x += 0.1
+        bpy.ops.render.render()
+        reused.append(addon.engine.last_render["stats"].extra["bvh_reused"])
+    assert reused[1:] == [True, False, True]

@@ -1,0 +1,53 @@
+"""The last render's BVH, kept for the next render of the same triangles.
+
+Frames of an animation in which only the camera, the lights, the materials or
+the world change, and the viewport's restarts after a view or material edit,
+render the same triangles again: they reuse the Embree BVH of the previous
+render instead of building it anew.  The triangles are recognised by a hash
+of the vertex and index arrays (BLAKE2b, about 1 ms per MB, far below the
+cost of a build).  One BVH is kept, the last one built; it is dropped before
+a different one is built, so at most one extra BVH stays in memory.
+"""
+from __future__ import annotations
+
+import hashlib
+import threading
+
+import numpy as np
+
+from .kernels.intersect import Accel
+
+__all__ = ["accel_for", "clear"]
+
+_lock = threading.Lock()
+_last: tuple[bytes, Accel] | None = None
+
+
+def _digest(vertices: np.ndarray, triangles: np.ndarray) -> bytes:
+    h = hashlib.blake2b(digest_size=32)
+    for array, dtype in ((vertices, np.float32), (triangles, np.int32)):
+        array = np.ascontiguousarray(array, dtype)
+        h.update(repr(array.shape).encode())
+        if array.size:          # (a view of no bytes cannot be cast)
+            h.update(memoryview(array).cast("B"))
+    return h.digest()
+
+
+def accel_for(vertices, triangles) -> tuple[Accel, bool]:
+    """A BVH of these triangles and whether it was reused (True) or built (False)."""
+    global _last
+    key = _digest(vertices, triangles)
+    with _lock:
+        if _last is not None and _last[0] == key:
+            return _last[1], True
+        _last = None               # free the old BVH before building the new one
+        accel = Accel(vertices, triangles)
+        _last = (key, accel)
+        return accel, False
+
+
+def clear() -> None:
+    """Forget the kept BVH (its memory is freed once no session uses it)."""
+    global _last
+    with _lock:
+        _last = None

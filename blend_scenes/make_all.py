@@ -37,6 +37,8 @@ SCENES = (
     "material_nodes",
     "material_suzanne",
     "material_rough_glass",
+    "caustics",
+    "caustics_point",
 )
 
 

@@ -4,10 +4,16 @@
 :class:`mcengine.scene.SceneDescription`, creates a render session and shows
 every progressive pass in the Render Result, with progress and statistics in
 the status bar.  Esc stops the render between passes (the session polls
-``test_break``) and keeps the partial image.  Material, light and world
-previews go through ``render`` too, with the preview's sampling
-(``preview.py``).  The viewport's Rendered mode is ``view_update`` and
-``view_draw``, thin calls into ``viewport.py``.
+``test_break``) and keeps the partial image.  At the end the render passes the
+view layer enables are written (``update_render_passes`` registers the same
+list for the compositor, as Cycles does), Combined is denoised when Cycles'
+denoising is on (the noisy image goes to "Noisy Image"), and the render's
+statistics and Cryptomatte manifests go to the result's metadata (shown in the
+image editor's Metadata panel, written to EXR headers).  Material, light and
+world previews go through ``render`` too, with the preview's sampling
+(``preview.py``), Combined only.  The viewport's Rendered mode is
+``view_update`` and ``view_draw``, thin calls into ``viewport.py`` (Combined
+only, not denoised).
 
 Errors never escape as tracebacks: an invalid scene or any failure becomes
 one ERROR report (and ``error_set``); unsupported features become one WARNING
@@ -23,10 +29,11 @@ import time
 import bpy
 import numpy as np
 
-from mcengine.scene import Camera, SceneError
+from mcengine.scene import Camera, Denoising, RenderPasses, SceneError
 
 from . import export
 from .export.camera import camera_from_view
+from .export.passes import result_passes
 from .export.settings import unit_scale
 from .preview import preview_integrator
 from .viewport import ViewportRender, draw_frame, parts_to_export, status_line
@@ -70,13 +77,25 @@ class MCEngine(bpy.types.RenderEngine):
     # (see preview.py).
     bl_use_preview = True
 
+    def update_render_passes(self, scene=None, renderlayer=None):
+        """Register the passes of ``renderlayer`` for the compositor (as Cycles lists them)."""
+        for name, channels, kind in result_passes(scene, renderlayer):
+            self.register_pass(scene, renderlayer, name, len(channels), channels, kind)
+
     def render(self, depsgraph):
+        t_start = time.perf_counter()
         desc, session = self._prepare(depsgraph)
         if session is None:
             return
         x0, y0, x1, y1 = desc.film.window
         self._pixels = (x1 - x0) * (y1 - y0)
-        result = self.begin_result(0, 0, x1 - x0, y1 - y0)
+        layer = depsgraph.view_layer.name
+        # Previews show Combined only, never denoised.
+        passes = ([("Combined", "RGBA", "COLOR")] if self.is_preview
+                  else result_passes(depsgraph.scene, depsgraph.view_layer))
+        for name, channels, _kind in passes[1:]:
+            self.add_pass(name, len(channels), channels, layer=layer)
+        result = self.begin_result(0, 0, x1 - x0, y1 - y0, layer=layer)
         progress = _Progress(desc.integrator.samples, desc.integrator.time_limit)
         try:
             session.run(on_pass=lambda s: self._publish(result, s, progress),
@@ -85,9 +104,15 @@ class MCEngine(bpy.types.RenderEngine):
             self._fail(_describe(exc, "rendering"), exc)
         finally:
             try:
-                self._write_pixels(result, session)  # the final (or partial) image
+                self._write_final(result, session, desc, [p[0] for p in passes[1:]])
             except Exception as exc:
                 self._fail(_describe(exc, "reading the image"), exc)
+            try:
+                if not self.is_preview:
+                    self._write_metadata(result, session, desc, layer,
+                                         time.perf_counter() - t_start)
+            except Exception as exc:
+                self._fail(_describe(exc, "writing the render statistics"), exc)
             self.end_result(result)
             if not self.is_preview:
                 self._record(depsgraph.scene.original, session)
@@ -153,8 +178,10 @@ class MCEngine(bpy.types.RenderEngine):
         seconds = time.perf_counter() - start
         self._export_seconds = seconds
         log.info("scene exported in %.3f s", seconds)
-        if self.is_preview:   # Blender's preview scene: few samples, no reports
+        if self.is_preview:   # Blender's preview scene: few samples, no reports, no passes
             exported.scene.integrator = preview_integrator(exported.scene.integrator)
+            exported.scene.passes = RenderPasses()
+            exported.scene.denoising = Denoising()
         for warning in () if self.is_preview else exported.scene.warnings:
             self.report({"WARNING"}, warning)
         # The first render after installing compiles the numba kernels (cached afterwards).
@@ -195,13 +222,57 @@ class MCEngine(bpy.types.RenderEngine):
 
     def _write_pixels(self, result, session) -> None:
         """Copy the session's image into the Combined pass (Blender's rows: bottom first)."""
-        image = np.asarray(session.image(bottom_up=True), np.float32)
-        width, height = result.resolution_x, result.resolution_y
-        if image.shape != (height, width, 4):
-            raise SceneError(f"the renderer returned an image of shape {image.shape} for a "
-                             f"{width}x{height} render region")
-        result.layers[0].passes["Combined"].rect.foreach_set(image.reshape(-1))
+        self._write_pass(result, "Combined", session.image(bottom_up=True))
         self.update_result(result)
+
+    def _write_pass(self, result, name: str, image) -> None:
+        """Copy an (h, w, C) image, bottom row first, into pass ``name`` of the result."""
+        image = np.asarray(image, np.float32)
+        width, height = result.resolution_x, result.resolution_y
+        target = result.layers[0].passes[name]
+        if image.shape != (height, width, target.channels):
+            raise SceneError(f"the renderer returned an image of shape {image.shape} for the "
+                             f"{width}x{height} pass {name!r} of {target.channels} channels")
+        target.rect.foreach_set(image.reshape(-1))
+
+    def _write_final(self, result, session, desc, names) -> None:
+        """The final (or partial) image, denoised if asked, and every render pass."""
+        available = set(session.pass_names())
+        noisy = session.image(bottom_up=True)
+        combined = noisy
+        if desc.denoising.enabled:
+            self.update_stats("", "Denoising")
+            try:
+                combined = session.denoised(bottom_up=True)
+            except Exception as exc:   # OIDN failed: the noisy image, and say so
+                self.report({"WARNING"}, f"MC Engine: {_describe(exc, 'denoising')}; "
+                                         f"the image is not denoised")
+        self._write_pass(result, "Combined", combined)
+        for name in names:
+            if name == "Noisy Image":
+                image = noisy
+            elif name in available:
+                image = session.pass_image(name, bottom_up=True)
+            else:   # a pass this render does not compute (the warning said so)
+                channels = result.layers[0].passes[name].channels
+                image = np.zeros((result.resolution_y, result.resolution_x, channels), np.float32)
+            self._write_pass(result, name, image)
+        self.update_result(result)
+
+    def _write_metadata(self, result, session, desc, layer: str, seconds: float) -> None:
+        """Render statistics and Cryptomatte manifests in the result's metadata."""
+        from mcengine.passes import cryptomatte_metadata
+        fields = {}
+        stats = getattr(session, "stats", None)
+        if hasattr(stats, "metadata"):
+            fields.update({f"mcengine.{layer}.{key}": value for key, value in
+                           stats.metadata(seconds, desc.integrator.samples).items()})
+        fields.update(cryptomatte_metadata(desc.passes, desc.geometry.object_pass_info(),
+                                           desc.materials, desc.geometry.material_index.tolist()))
+        # The engine's whole result, as Cycles does (a tile's metadata is not merged into it).
+        full = self.get_result() or result
+        for key, value in fields.items():
+            full.stamp_data_add_field(key, value)
 
     def _stop_requested(self) -> bool:
         """Polled by the session: True once the user pressed Esc."""

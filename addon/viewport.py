@@ -22,7 +22,8 @@ needs no window and is tested headless:
 
 Viewport sampling follows Cycles' viewport settings: ``preview_samples``
 samples per pixel (0: until the view changes), no time limit, no adaptive
-sampling.
+sampling.  The viewport renders Combined only: no render passes and no
+denoising (F12 has them).
 
 :func:`draw_frame` is the only code that needs a window: it draws the image
 with Blender's ``gpu`` module through the scene's display transform.
@@ -34,7 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mcengine.scene import Film, Integrator, SceneDescription
+from mcengine.scene import Denoising, Film, Integrator, RenderPasses, SceneDescription
 
 from .export import PARTS
 
@@ -214,7 +215,8 @@ class ViewportRender:
             self.stop()
             self._key = key
             self._job = _Job(self._factory, replace(scene, camera=camera, film=film,
-                                                    integrator=integrator))
+                                                    integrator=integrator, passes=RenderPasses(),
+                                                    denoising=Denoising()))
         return self._job.frame()
 
     def stop(self) -> None:

@@ -8,6 +8,10 @@ pixel mean.  Memory is proportional to the film region, never to samples:
 ``memory.FILM_BYTES_PER_PIXEL`` for the sums, and read-out works through
 blocks of rows, so it needs no full-frame float64 temporaries, only the
 float32 image it returns.
+
+Render passes other than Combined accumulate in ``passes``, one row of
+``pass_stride`` float64 sums per pixel (``mcengine.passes`` lays them out and
+reads them); a render without passes has none.
 """
 from __future__ import annotations
 
@@ -19,12 +23,15 @@ BLOCK_PIXELS = 1 << 16     # pixels per read-out block (temporaries of a few MB)
 class Film:
     """Accumulators for a ``width`` x ``height`` region (row 0 at the top)."""
 
-    def __init__(self, width: int, height: int):
+    def __init__(self, width: int, height: int, pass_stride: int = 0):
         self.width, self.height = int(width), int(height)
         n = self.width * self.height
         self.sum = np.zeros((n, 4))          # radiance RGB and alpha
         self.sum_sq = np.zeros((n, 3))       # squared radiance
         self.count = np.zeros(n, np.int32)   # finished samples
+        # Render passes' sums (kernels.passes); one column when there are none, so the
+        # kernels see the same array type either way.
+        self.passes = np.zeros((n if pass_stride else 1, max(int(pass_stride), 1)))
 
     @property
     def arrays(self):
@@ -49,6 +56,24 @@ class Film:
             block = self.sum[a:b] / np.maximum(self.count[a:b], 1)[:, None]
             block[:, :3] *= exposure
             rows = block.reshape(r1 - r0, w, 4)
+            if bottom_up:
+                out[h - r1:h - r0] = rows[::-1]
+            else:
+                out[r0:r1] = rows
+        return out
+
+    def pass_image(self, name: str, layout, exposure: float = 1.0, bottom_up: bool = False
+                   ) -> np.ndarray:
+        """(h, w, C) float32 image of render pass ``name`` (``mcengine.passes.read``)."""
+        from .passes import read
+        w, h = self.width, self.height
+        out = None
+        for r0, r1 in self._row_blocks():
+            a, b = r0 * w, r1 * w
+            block = read(name, self.passes[a:b], self.count[a:b], layout, exposure)
+            if out is None:
+                out = np.empty((h, w, block.shape[1]), np.float32)
+            rows = block.reshape(r1 - r0, w, -1)
             if bottom_up:
                 out[h - r1:h - r0] = rows[::-1]
             else:

@@ -61,6 +61,35 @@ def read_exr(path) -> np.ndarray:
     return img
 
 
+def read_exr_layers(path) -> dict:
+    """Every channel group of an EXR, single- or multi-part (a multilayer file written by
+    Blender: one part per pass), decoded in full: name ("ViewLayer.Depth.Z", or
+    "ViewLayer.Combined" for its RGBA) -> (h, w) or (h, w, C) float32 array."""
+    import OpenEXR
+    try:
+        with OpenEXR.File(str(path), separate_channels=False) as f:
+            layers = {}
+            for part in f.parts:
+                for name, channel in part.channels.items():
+                    layers[name] = np.asarray(channel.pixels, np.float32)
+    except Exception as exc:
+        raise ImageError(f"cannot read {path}: {exc}") from None
+    if not layers:
+        raise ImageError(f"{path}: no channels")
+    return layers
+
+
+def read_exr_header(path) -> dict:
+    """The first part's header of an EXR: metadata name -> value (strings as str)."""
+    import OpenEXR
+    try:
+        with OpenEXR.File(str(path), header_only=True) as f:
+            header = dict(f.parts[0].header)
+    except Exception as exc:
+        raise ImageError(f"cannot read {path}: {exc}") from None
+    return {k: (v.decode() if isinstance(v, bytes) else v) for k, v in header.items()}
+
+
 def linear_to_srgb(x) -> np.ndarray:
     """The sRGB transfer curve (Blender's Standard view), input clipped to [0, 1]."""
     x = np.clip(np.asarray(x, np.float64), 0.0, 1.0)

@@ -52,11 +52,12 @@ class MemoryEstimate:
                 f"{self.scene / GIB:.2f})")
 
 
-def estimate(pixels: int, triangles: int, buffer_bytes: int, host_bytes_per_pixel: int = 0
-             ) -> MemoryEstimate:
-    """Memory a render of ``pixels`` pixels and ``triangles`` triangles needs, in bytes."""
+def estimate(pixels: int, triangles: int, buffer_bytes: int, host_bytes_per_pixel: int = 0,
+             pass_bytes_per_pixel: int = 0) -> MemoryEstimate:
+    """Memory a render of ``pixels`` pixels and ``triangles`` triangles needs, in bytes
+    (``pass_bytes_per_pixel``: the film's render-pass sums)."""
     return MemoryEstimate(
-        film=pixels * FILM_BYTES_PER_PIXEL,
+        film=pixels * (FILM_BYTES_PER_PIXEL + pass_bytes_per_pixel),
         host_image=pixels * (IMAGE_BYTES_PER_PIXEL + host_bytes_per_pixel),
         buffers=buffer_bytes,
         scene=triangles * BYTES_PER_TRIANGLE)

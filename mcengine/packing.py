@@ -4,8 +4,9 @@ The scene model (``scene``) is made for people and files; the kernels want
 contiguous float64/int32 tables with fixed columns (``kernels.state``,
 ``kernels.lights``, ``kernels.camera``), the shader programs (``shaders``), the light
 picking distributions, and two small settings vectors (``cfg`` integers,
-``fcfg`` floats) that also carry the effects plan of ``features``.  This module
-builds all of them once per render.
+``fcfg`` floats) that also carry the effects plan of ``features``; and, for render
+passes, the per-triangle data they read (``pack_passes``).  This module builds
+all of them once per render.
 """
 from __future__ import annotations
 
@@ -14,12 +15,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import integrators, samplers
+from . import cryptomatte, integrators, samplers
 from .features import EffectsPlan, lamps_intersectable
 from .features import detect as detect_plan
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
+from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, PassData
 from .kernels.sampling import SAMPLER_INDEPENDENT, filter_table
 from .kernels.shading import emission_estimates
 from .kernels.sobol import index_mask
@@ -64,6 +66,7 @@ from .kernels.svm import (
     OBJ_TEXSPACE_SIZE,
     TextureData,
 )
+from .passes import kernel_data
 from .scene import SceneDescription
 from .shaders import AttributeLayout, ShaderTable
 
@@ -249,3 +252,29 @@ def _areas_and_normals(verts, tris, block: int = 1 << 16):
         tri_area[a:a + block] = 0.5 * length
         tri_normal[a:a + block] = cross / np.where(length > 0, length, 1.0)[:, None]
     return tri_area, tri_normal
+
+
+def pack_passes(scene: SceneDescription, lay) -> PassData:
+    """The render passes' kernel data (``kernels.passes.PassData``) for the film layout
+    ``lay`` (``passes.layout``): per-triangle UVs, object pass indices and Cryptomatte
+    ids, per-material pass indices and ids, only for the passes that read them."""
+    g = scene.geometry
+    t = g.num_triangles
+    tri_uv = np.zeros((1, 3, 3), np.float32)
+    objects = g.object_pass_info()
+    if P_UV in lay and t:
+        has_uv = np.array([o.has_uv for o in objects] or [False], np.float32)[g.object_index]
+        tri_uv = np.ascontiguousarray(np.concatenate(
+            [g.uvs, np.broadcast_to(has_uv[:, None, None], (t, 3, 1))], axis=2), np.float32)
+    tri_object = np.zeros((1, 3), np.float32)
+    if t and any(s in lay for s in (P_OBJECT_ID, P_CRYPTO_OBJECT, P_CRYPTO_ASSET)):
+        pass_index = g.object_arrays()[2][:, 1]      # Object Info's pass index
+        table = np.array([[index, cryptomatte.name_id(o.name), cryptomatte.name_id(o.asset)]
+                          for index, o in zip(pass_index, objects)] or [[0.0, 0.0, 0.0]],
+                         np.float32)
+        tri_object = np.ascontiguousarray(table[g.object_index])
+    mat_info = np.array([[m.pass_index, cryptomatte.name_id(m.name)] for m in scene.materials],
+                        np.float32).reshape(-1, 2)
+    cam = scene.camera
+    return kernel_data(lay, scene.passes, np.asarray(cam.matrix_world, float), cam.type == "ORTHO",
+                       tri_uv, tri_object, mat_info)

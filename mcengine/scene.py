@@ -28,10 +28,12 @@ from pathlib import Path
 import numpy as np
 
 from . import integrators, memory, samplers
+from .denoise import Denoising
+from .passes import RenderPasses
 
 __all__ = [
-    "SceneError", "Geometry", "Link", "ShaderNode", "Material", "Light", "Camera", "World", "Film",
-    "Integrator", "SceneDescription",
+    "SceneError", "ObjectPassInfo", "Geometry", "Link", "ShaderNode", "Material", "Light", "Camera",
+    "World", "Film", "Integrator", "SceneDescription", "RenderPasses", "Denoising",
 ]
 
 LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
@@ -47,6 +49,19 @@ FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
 
 class SceneError(ValueError):
     """The scene description is invalid; the message says what and where."""
+
+
+@dataclass
+class ObjectPassInfo:
+    """What render passes know of an object besides its Object Info (``Geometry.object_info``,
+    which holds its pass index): its own name (the Cryptomatte object id; an instance's is
+    the instanced object's), the name of its topmost parent (the Cryptomatte asset id; its
+    own name without a parent), and whether its mesh has a UV map (else the UV pass reads 0,
+    as in Cycles)."""
+
+    name: str = ""
+    asset: str = ""
+    has_uv: bool = True
 
 
 @dataclass
@@ -69,6 +84,8 @@ class Geometry:
     object_texspace (O, 2, 3) float64  generated texture space: centre and half-size
                     (object space; Blender's texspace_location and texspace_size)
     object_info     (O, 6) float64     Object Info: random, pass index, colour RGBA
+    object_passes   per entry of ``object_names``, its :class:`ObjectPassInfo` (render passes;
+                    empty: each object is named by its ``object_names`` entry)
     """
 
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
@@ -82,6 +99,7 @@ class Geometry:
     object_matrix: np.ndarray | None = None
     object_texspace: np.ndarray | None = None
     object_info: np.ndarray | None = None
+    object_passes: list = field(default_factory=list)
 
     @property
     def num_objects(self) -> int:
@@ -110,6 +128,12 @@ class Geometry:
             texspace[seen, 0] = 0.5 * (lo[seen] + hi[seen])
             texspace[seen, 1] = 0.5 * (hi[seen] - lo[seen])
         return matrix, auto_texspace_size(texspace), info
+
+    def object_pass_info(self) -> list:
+        """An :class:`ObjectPassInfo` per entry of ``object_names``."""
+        if len(self.object_passes) == len(self.object_names):
+            return list(self.object_passes)
+        return [ObjectPassInfo(name, name) for name in self.object_names]
 
     @property
     def num_triangles(self) -> int:
@@ -161,13 +185,14 @@ class Geometry:
                 columns.append(full)
             attributes[name] = np.concatenate(columns)
         objects = [g.object_arrays() for g in parts]
-        verts, tris, names, objs = [], [], [], []
+        verts, tris, names, objs, infos = [], [], [], [], []
         v_off = 0
         for g in parts:
             verts.append(g.vertices)
             tris.append(g.triangles + v_off)
             objs.append(g.object_index + len(names))
             names.extend(g.object_names)
+            infos.extend(g.object_pass_info())
             v_off += g.vertices.shape[0]
         return Geometry(
             vertices=np.concatenate(verts), triangles=np.concatenate(tris),
@@ -177,7 +202,7 @@ class Geometry:
             object_index=np.concatenate(objs), object_names=names, attributes=attributes,
             object_matrix=np.concatenate([o[0] for o in objects]),
             object_texspace=np.concatenate([o[1] for o in objects]),
-            object_info=np.concatenate([o[2] for o in objects]))
+            object_info=np.concatenate([o[2] for o in objects]), object_passes=infos)
 
 
 def auto_texspace_size(texspace: np.ndarray) -> np.ndarray:
@@ -240,6 +265,7 @@ class Material:
     surface: Link | None = None
     use_transparent_shadow: bool = True
     use_bump_map_correction: bool = True
+    pass_index: int = 0
     base_color: tuple = (0.8, 0.8, 0.8)
     emission: tuple = (0.0, 0.0, 0.0)
     mirror_color: tuple = (0.0, 0.0, 0.0)
@@ -413,6 +439,8 @@ class SceneDescription:
     world: World = field(default_factory=World)
     film: Film = field(default_factory=Film)
     integrator: Integrator = field(default_factory=Integrator)
+    passes: RenderPasses = field(default_factory=RenderPasses)
+    denoising: Denoising = field(default_factory=Denoising)
     warnings: list = field(default_factory=list)
 
     # -- validation --------------------------------------------------------
@@ -523,6 +551,8 @@ class SceneDescription:
         for attr in ("clamp_direct", "clamp_indirect", "filter_glossy", "time_limit",
                      "adaptive_threshold"):
             _check_number("integrator", attr, getattr(i, attr), lo=0.0)
+        for problem in self.passes.check() + self.denoising.check():
+            raise SceneError(problem)
         return self
 
     # -- persistence -------------------------------------------------------
@@ -531,12 +561,15 @@ class SceneDescription:
         g = self.geometry
         meta = {
             "object_names": g.object_names,
+            "object_passes": [dataclasses.asdict(o) for o in g.object_passes],
             "materials": [dataclasses.asdict(m) for m in self.materials],
             "lights": [_light_meta(li) for li in self.lights],
             "camera": _plain(dataclasses.asdict(self.camera)),
             "world": dataclasses.asdict(self.world),
             "film": dataclasses.asdict(self.film),
             "integrator": dataclasses.asdict(self.integrator),
+            "passes": dataclasses.asdict(self.passes),
+            "denoising": dataclasses.asdict(self.denoising),
             "warnings": list(self.warnings),
         }
         matrix, texspace, info = g.object_arrays()
@@ -626,7 +659,8 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
                     object_index=z["object_index"], object_names=list(meta["object_names"]),
                     attributes={str(name): z[f"attribute{k}"] for k, name in enumerate(names)},
                     object_matrix=z.get("object_matrix"), object_texspace=z.get("object_texspace"),
-                    object_info=z.get("object_info"))
+                    object_info=z.get("object_info"),
+                    object_passes=[ObjectPassInfo(**o) for o in meta.get("object_passes", [])])
     lights = []
     for d in meta["lights"]:
         d = dict(d)
@@ -644,6 +678,9 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
         lights=lights, camera=Camera(**cam),
         world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
         film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
+        passes=RenderPasses(**{k: (tuple(v) if isinstance(v, list) else v)
+                               for k, v in meta.get("passes", {}).items()}),
+        denoising=Denoising(**meta.get("denoising", {})),
         warnings=list(meta.get("warnings", [])))
 
 

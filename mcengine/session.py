@@ -5,6 +5,8 @@ Typical use::
     session = RenderSession(scene)          # validates, builds the BVH, loads kernels
     session.run(on_pass=show, should_stop=esc_pressed)
     rgba = session.image()                  # (h, w, 4) float32, top row first
+    depth = session.pass_image("Depth")     # render passes the scene asks for
+    clean = session.denoised()              # with the scene's denoising settings
 
 ``run`` renders progressive passes until ``scene.integrator.samples`` samples
 per pixel are done, the time limit is reached or ``should_stop()`` returns
@@ -29,11 +31,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import accel_cache, memory
+from . import passes as render_passes
 from .adaptive import Adaptive
+from .denoise import denoise
 from .film import Film
 from .integrators import get as integrator_info
 from .kernels import classic, path
 from .kernels.classic import WHITTED_RAYS
+from .kernels.passes import P_DENOISING_ALBEDO, P_DENOISING_NORMAL, PC_DENOISE, PC_LIGHT, alloc_pass_buffers
 from .kernels.state import (
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
@@ -46,7 +51,7 @@ from .kernels.state import (
     alloc_shadow_queue,
 )
 from .kernels.svm import OP_CLOSURE
-from .packing import pack_scene
+from .packing import pack_passes, pack_scene
 from .scene import SceneDescription, SceneError
 
 DEFAULT_BATCH = 1 << 17       # paths per chunk: ~50 MB of buffers per worker
@@ -101,6 +106,18 @@ class RenderStats:
                 "tracing": self.time_embree, "shading": max(self.time_workers - self.time_embree, 0.0),
                 "render": self.time_render}
 
+    def metadata(self, total_seconds: float, samples: int) -> dict:
+        """Statistics for the image's metadata, named and formatted as Cycles' (its keys
+        after "cycles.<view layer>."; times as "MM:SS.hh"): ``samples`` (configured),
+        ``total_time``, ``render_time``, ``synchronization_time`` (total less render);
+        and ``samples_rendered``, ``rays_per_second``, ``nonfinite_samples``."""
+        render = min(self.time_render, total_seconds)
+        return {"samples": str(int(samples)), "samples_rendered": str(int(self.samples_done)),
+                "total_time": clock_text(total_seconds), "render_time": clock_text(render),
+                "synchronization_time": clock_text(total_seconds - render),
+                "rays_per_second": f"{self.rays_per_second:.0f}",
+                "nonfinite_samples": str(int(self.nonfinite))}
+
     def accounting(self, pixels: int, time_export: float = 0.0) -> str:
         """One line: rays per pixel by kind, Mrays/s, time per phase, and the count of
         non-finite samples dropped when there were any (so a bug cannot hide behind the guard)."""
@@ -114,6 +131,16 @@ class RenderStats:
         if self.nonfinite:
             line += f" | {self.nonfinite:,} non-finite samples dropped"
         return line
+
+
+def clock_text(seconds: float) -> str:
+    """Cycles' time_human_readable_from_seconds: "MM:SS.hh", or "HH:MM:SS.hh" from an hour."""
+    seconds = max(float(seconds), 0.0)
+    whole = int(seconds)
+    h, m, sec, hundredths = whole // 3600, (whole // 60) % 60, whole % 60, int(seconds * 100) % 100
+    if h > 0:
+        return f"{h:02d}:{m:02d}:{sec:02d}.{hundredths:02d}"
+    return f"{m:02d}:{sec:02d}.{hundredths:02d}"
 
 
 class _TimedAccel:
@@ -147,35 +174,37 @@ class _Buffers:
     _pool: dict = {}
     _pool_lock = threading.Lock()
 
-    def __init__(self, batch, classic):
-        self.key = (batch, classic)
+    def __init__(self, batch, classic, passes=False):
+        self.key = (batch, classic, passes)
         self.state = alloc_path_state(batch)
         self.shadow = alloc_shadow_queue(batch)
+        # Render passes' per-path buffers: full size only for light passes or denoising.
+        self.passes = alloc_pass_buffers(batch if passes else 1)
         if classic:   # a second generation of rays and per-camera-sample sums
             self.next_state = alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
             self.root_pixel = np.zeros(batch, np.int32)
 
     @staticmethod
-    def bytes_for(batch, classic) -> int:
+    def bytes_for(batch, classic, passes=False) -> int:
         """Memory of one worker's buffers for ``batch`` paths (without allocating them)."""
-        one, two = _Buffers(1, classic).nbytes, _Buffers(2, classic).nbytes
+        one, two = _Buffers(1, classic, passes).nbytes, _Buffers(2, classic, passes).nbytes
         return (two - one) * batch + (2 * one - two)     # per path, plus the fixed part
 
     @property
     def nbytes(self) -> int:
-        arrays = [*self.state, *self.shadow]
+        arrays = [*self.state, *self.shadow, *self.passes]
         if self.key[1]:
             arrays += [*self.next_state, self.acc, self.root_pixel]
         return sum(a.nbytes for a in arrays)
 
     @classmethod
-    def take(cls, batch, classic) -> "_Buffers":
+    def take(cls, batch, classic, passes=False) -> "_Buffers":
         with cls._pool_lock:
-            free = cls._pool.get((batch, classic))
+            free = cls._pool.get((batch, classic, passes))
             if free:
                 return free.pop()
-        return cls(batch, classic)
+        return cls(batch, classic, passes)
 
     def give_back(self) -> None:
         with self._pool_lock:
@@ -215,9 +244,16 @@ class RenderSession:
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
         self.integrator = integrator_info(it.name)
         self._classic_setup()
+        guides = ((P_DENOISING_ALBEDO,) if scene.denoising.uses_albedo else ()) + \
+            ((P_DENOISING_NORMAL,) if scene.denoising.uses_normal else ())
+        self.pass_layout = render_passes.layout(scene.passes, guides)
+        self.pd = pack_passes(scene, self.pass_layout)
+        # Per-path pass buffers are needed by light passes and denoising features only.
+        self._path_passes = bool(self.pd.cfg[PC_LIGHT]
+                                 or self.pd.cfg[PC_DENOISE])
         x0, y0, x1, y1 = scene.film.window
         self._check_memory((x1 - x0) * (y1 - y0), host_bytes_per_pixel)
-        self.film = Film(x1 - x0, y1 - y0)
+        self.film = Film(x1 - x0, y1 - y0, self.pass_layout.stride)
         self.adaptive = Adaptive.from_settings(it)
         self.active = np.arange(self.film.count.size, dtype=np.int32)
         self.pass_samples = 0          # samples every still-active pixel has
@@ -243,6 +279,31 @@ class RenderSession:
     def image(self, bottom_up: bool = False) -> np.ndarray:
         """(h, w, 4) float32 linear RGBA of the film region, top row first (or last)."""
         return self.film.image(self.scene.film.exposure, bottom_up)
+
+    def pass_names(self) -> list[str]:
+        """The render passes besides Combined, in Blender's order (``RenderPasses.names``)."""
+        return self.scene.passes.names()
+
+    def pass_image(self, name: str, bottom_up: bool = False) -> np.ndarray:
+        """(h, w, C) float32 image of render pass ``name`` (one of ``pass_names()``)."""
+        return self.film.pass_image(name, self.pass_layout, self.scene.film.exposure, bottom_up)
+
+    def denoised(self, bottom_up: bool = False) -> np.ndarray | None:
+        """The image denoised with the scene's settings (None when denoising is off).
+
+        Raises ``denoise.DenoiseError`` if Open Image Denoise is missing or fails.
+        """
+        d = self.scene.denoising
+        if not d.enabled:
+            return None
+        albedo = self._guide("Denoising Albedo", d.uses_albedo, bottom_up)
+        normal = self._guide("Denoising Normal", d.uses_normal, bottom_up)
+        return denoise(self.image(bottom_up), d, albedo, normal)
+
+    def _guide(self, name: str, used: bool, bottom_up: bool):
+        if not used:
+            return None
+        return self.film.pass_image(name, self.pass_layout, 1.0, bottom_up)
 
     def variance(self) -> np.ndarray:
         """(h, w, 3) float32 variance of each pixel's mean (inf below 2 samples)."""
@@ -300,7 +361,7 @@ class RenderSession:
     @property
     def buffer_bytes(self) -> int:
         """Memory of the wavefront buffers and the film (bounded by batch size and resolution)."""
-        return sum(a.nbytes for a in self.film.arrays) + self._buffer_bytes
+        return sum(a.nbytes for a in self.film.arrays) + self.film.passes.nbytes + self._buffer_bytes
 
     # -- internals -----------------------------------------------------------------------
     @property
@@ -330,8 +391,9 @@ class RenderSession:
     def _check_memory(self, pixels: int, host_bytes_per_pixel: int) -> None:
         """SceneError, with the figures, if the render cannot fit in the memory left."""
         need = memory.estimate(pixels, self.scene.geometry.num_triangles,
-                               self.threads * _Buffers.bytes_for(self.batch_size, self._classic),
-                               host_bytes_per_pixel)
+                               self.threads * _Buffers.bytes_for(self.batch_size, self._classic,
+                                                                 self._path_passes),
+                               host_bytes_per_pixel, 8 * self.pass_layout.stride)
         free = memory.available()
         if free is not None and need.total > free:
             raise SceneError(f"not enough memory: this render needs {need.describe()}, "
@@ -373,7 +435,8 @@ class RenderSession:
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(_Buffers.take(self.batch_size, self._classic), self.accel, self.sc)
+            w = _Worker(_Buffers.take(self.batch_size, self._classic, self._path_passes), self.accel,
+                        self.sc)
             self._workers.w = w
             scratch = sum(a.nbytes for a in w.scratch)
             self._buffer_bytes = max(self._buffer_bytes, self.threads * (w.buffers.nbytes + scratch))
@@ -381,11 +444,11 @@ class RenderSession:
                 self._all_workers.append(w)
         return w
 
-    def _trace_with(self, w, pixels, spp, film):
+    def _trace_with(self, w, pixels, spp, film, pass_film):
         b = w.buffers
         if not self._classic:
             path.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
-                             w.scratch, film, w.stats)
+                             w.scratch, film, w.stats, self.pd, b.passes, pass_film)
         else:
             classic.trace_chunk_classic(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg,
                                         (b.state, b.next_state, b.shadow, b.acc, b.root_pixel,
@@ -397,14 +460,15 @@ class RenderSession:
             return
         w = self._worker()
         t0 = time.perf_counter()
-        self._trace_with(w, pixels, spp, self.film.arrays)
+        self._trace_with(w, pixels, spp, self.film.arrays, self.film.passes)
         w.busy += time.perf_counter() - t0
 
     def _warm_up(self):
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
         size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self._classic else 64
-        self._trace_with(_Worker(_Buffers(size, self._classic), self.accel, self.sc),
-                         np.zeros(1, np.int32), 1, Film(1, 1).arrays)
+        scratch_film = Film(1, 1, self.pass_layout.stride)
+        self._trace_with(_Worker(_Buffers(size, self._classic, self._path_passes), self.accel, self.sc),
+                         np.zeros(1, np.int32), 1, scratch_film.arrays, scratch_film.passes)
 
     def _update_stats(self, t_start):
         s = self.stats

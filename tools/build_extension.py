@@ -55,9 +55,10 @@ DEFAULT_OUT = REPO / "dist" / "extension"
 DEFAULT_WHEEL_CACHE = REPO / "build" / "wheels"
 
 CORE_DISTRIBUTION = "mcengine"
-# Blender 5.0 for Linux x86-64 runs CPython 3.11 and needs glibc 2.28 (manylinux_2_28).
+# Blender 5.0 for Linux x86-64 runs CPython 3.11 on glibc 2.28 (manylinux_2_28), which also
+# runs wheels built for older glibc (manylinux2014 = manylinux_2_17: cffi, pyoidn).
 PIP_TARGET = ["--python-version", "3.11", "--implementation", "cp", "--abi", "cp311",
-              "--platform", "manylinux_2_28_x86_64"]
+              "--platform", "manylinux_2_28_x86_64", "--platform", "manylinux2014_x86_64"]
 # Wheels are zip files; a fixed timestamp makes the core wheel byte-for-byte reproducible.
 ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
 SKIPPED_DIRS = {"__pycache__"}
@@ -146,6 +147,7 @@ def build_core_wheel(dest: Path, version: str, core_dir: Path = CORE_DIR) -> Pat
         "Requires-Dist: embreex>=4.4",
         "Requires-Dist: numba>=0.60",
         "Requires-Dist: OpenEXR>=3.3",
+        "Requires-Dist: pyoidn>=2.5",
         "", ""])
     wheel_info = "\n".join([
         "Wheel-Version: 1.0",

@@ -290,8 +290,8 @@ def write_folder(write, result, folder) -> dict:
 def verify(path, file_format: str | None = None) -> tuple[int, int] | None:
     """Raise OutputError unless ``path`` holds a complete file of its format.
 
-    ``file_format`` is "OPEN_EXR" or "PNG" (default: from the extension; other
-    files are only checked to be non-empty).  Returns (width, height) of an
+    ``file_format`` is "OPEN_EXR", "OPEN_EXR_MULTILAYER" or "PNG" (default: from the
+    extension; other files are only checked to be non-empty).  Returns (width, height) of an
     image.  The error's message says what the file is instead, as a noun
     phrase ("an incomplete EXR file"), for the caller's sentence.
     """
@@ -306,6 +306,8 @@ def verify(path, file_format: str | None = None) -> tuple[int, int] | None:
         raise OutputError("an empty file")
     if file_format == "OPEN_EXR":
         return verify_exr(path)
+    if file_format == "OPEN_EXR_MULTILAYER":
+        return verify_exr_layers(path)
     if file_format == "PNG":
         return verify_png(path)
     return None
@@ -319,6 +321,17 @@ def verify_exr(path) -> tuple[int, int]:
     except ImageError:
         raise OutputError("an incomplete or unreadable EXR file") from None
     return image.shape[1], image.shape[0]
+
+
+def verify_exr_layers(path) -> tuple[int, int]:
+    """Decode every layer and pass of a multilayer (multi-part) EXR."""
+    from mcengine.imageio import ImageError, read_exr_layers
+    try:
+        layers = read_exr_layers(path)
+    except ImageError:
+        raise OutputError("an incomplete or unreadable EXR file") from None
+    first = next(iter(layers.values()))
+    return first.shape[1], first.shape[0]
 
 
 def verify_png(path) -> tuple[int, int]:

@@ -71,12 +71,16 @@ def apply_overrides(scene, *, engine=None, samples=None, seed=None, resolution=N
 
 
 def set_image_format(scene, file_format: str) -> None:
-    """Save images as ``file_format``: OPEN_EXR (32-bit float RGBA) or PNG (8-bit RGBA)."""
+    """Save images as ``file_format``: OPEN_EXR (32-bit float RGBA), OPEN_EXR_MULTILAYER
+    (every pass, 32-bit float; Blender 5.0 calls it a multi-layer image) or PNG (8-bit RGBA)."""
     settings = scene.render.image_settings
-    settings.media_type = "IMAGE"
-    settings.file_format = file_format
+    if file_format == "OPEN_EXR_MULTILAYER":
+        settings.media_type = "MULTI_LAYER_IMAGE"
+    else:
+        settings.media_type = "IMAGE"
+        settings.file_format = file_format
     settings.color_mode = "RGBA"
-    settings.color_depth = "32" if file_format == "OPEN_EXR" else "8"
+    settings.color_depth = "8" if file_format == "PNG" else "32"
 
 
 def make_unbiased(scene):

@@ -64,7 +64,9 @@ Conventions
   ``scene.cycles.samples`` and the seed to ``scene.cycles.seed`` (MC Engine reads
   Cycles' sampling settings); ``--resolution`` sets x, y and 100 %.
 * EXR output is OPEN_EXR, 32-bit float RGBA, scene-linear, with the file's EXR
-  codec; PNG output is 8-bit RGBA through the file's view transform.
+  codec; OPEN_EXR_MULTILAYER (``-F``) writes every render pass of every view
+  layer, 32-bit float, with the render's metadata (statistics, Cryptomatte
+  manifests); PNG output is 8-bit RGBA through the file's view transform.
 * Blender's own log is captured: shown with ``--verbose`` or when a render fails,
   otherwise only its ``Warning:`` lines are passed on.
 * Progress goes to stderr: a bar redrawn in place on a terminal, one line per

@@ -46,9 +46,10 @@ __all__ = ["RenderRequest", "CompareRequest", "StudyRequest", "Output", "parse_a
 DEFAULT_ENGINE = ENGINES["mcengine"]
 
 
-# Blender image format -> file extension.  Only the two formats whose pixel
-# meaning is unambiguous are offered: linear float EXR and display-referred PNG.
-FORMATS = {"OPEN_EXR": ".exr", "PNG": ".png"}
+# Blender image format -> file extension.  Only the formats whose pixel meaning is
+# unambiguous are offered: linear float EXR (Combined only, or every render pass
+# and view layer in one multilayer file) and display-referred PNG.
+FORMATS = {"OPEN_EXR": ".exr", "OPEN_EXR_MULTILAYER": ".exr", "PNG": ".png"}
 DEFAULT_FORMAT = "OPEN_EXR"
 # Extensions of other image formats: a name ending in one of these is a mistake,
 # not a name to which ".exr" should be appended.
@@ -314,7 +315,8 @@ def build_parser() -> argparse.ArgumentParser:
                              "'#' = frame digits; repeat to save several formats "
                              "(default: ./SCENE.exr)")
     render.add_argument("-F", "--render-format", dest="format", type=_format, default=None,
-                        metavar="FORMAT", help="OPEN_EXR or PNG (default: from the extension, else OPEN_EXR)")
+                        metavar="FORMAT", help="OPEN_EXR, OPEN_EXR_MULTILAYER (every render pass) or "
+                                               "PNG (default: from the extension, else OPEN_EXR)")
     render.add_argument("-S", "--scene", default=None, help="scene to render (default: the file's active scene)")
     render.add_argument("-t", "--threads", type=_threads, default=None,
                         help="CPU threads, 0 = all (default: the file's setting)")
@@ -552,7 +554,7 @@ def _output_for(raw: str, forced_format: str | None, blend_dir: Path,
     by_extension = next((fmt for fmt, ext in FORMATS.items() if ext == suffix), None)
     if suffix in OTHER_IMAGE_EXTENSIONS:
         raise CliError(f"unsupported output type {suffix!r} in {raw} (use .exr or .png)")
-    if forced_format and by_extension and by_extension != forced_format:
+    if forced_format and by_extension and suffix != FORMATS[forced_format]:
         raise CliError(f"output {raw} has extension {suffix} but the format is {forced_format}")
     file_format = forced_format or by_extension or DEFAULT_FORMAT
     extension = pattern.suffix if by_extension else FORMATS[file_format]

@@ -95,7 +95,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
         If the scene cannot be rendered at all (no camera, panoramic camera).
     """
     from . import camera as cameras
-    from . import settings, world
+    from . import passes, settings, world
 
     scene = depsgraph.scene
     ctx = ExportContext(scene)
@@ -127,6 +127,12 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
         integrator=(settings.export_integrator(ctx, scene, depsgraph.view_layer)
                     if "settings" in parts else old.integrator),
     )
+    if "settings" in parts:
+        desc.passes = passes.export_passes(ctx, scene, depsgraph.view_layer, desc.integrator.name)
+        desc.denoising = passes.export_denoising(ctx, scene, depsgraph.view_layer,
+                                                 desc.integrator.name)
+    else:
+        desc.passes, desc.denoising = old.passes, old.denoising
     desc.warnings = list(ctx.warnings)
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 

@@ -71,7 +71,8 @@ def convert_material(ctx, material) -> Material:
     name = material.name
     settings = dict(use_transparent_shadow=bool(getattr(material, "use_transparent_shadow", True)),
                     use_bump_map_correction=bool(getattr(getattr(material, "cycles", None),
-                                                         "use_bump_map_correction", True)))
+                                                         "use_bump_map_correction", True)),
+                    pass_index=int(getattr(material, "pass_index", 0)))
     tree = material.node_tree
     if tree is None:
         return Material(name=name, base_color=clamp_color(material.diffuse_color[:3]), **settings)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from mcengine.scene import Geometry, auto_texspace_size
+from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
 
 __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances"]
 
@@ -112,6 +112,7 @@ class MeshCollector:
         self._matrices: dict[tuple, list] = {}
         self._names: dict[tuple, list] = {}
         self._infos: dict[tuple, list] = {}
+        self._passes: dict[tuple, list] = {}
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
         self._noted: dict[str, list] = {}
 
@@ -139,11 +140,13 @@ class MeshCollector:
         if key not in self._meshes:
             self._meshes[key] = read_local_mesh(ob, slots, self._materials.attribute_names())
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
+            self._passes[key] = []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
             self._infos[key].append([float(inst.random_id & 0xFFFFFFFF), float(ob.pass_index),
                                      *(float(c) for c in ob.color)])
+            self._passes[key].append(object_pass_info(ob))
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -155,7 +158,10 @@ class MeshCollector:
         parts = [(mesh, np.stack(self._matrices[key]), self._names[key],
                   np.array(self._infos[key], np.float64))
                  for key, mesh in self._meshes.items() if mesh is not None]
-        return _place_all(parts, self._ctx.unit_scale)
+        geometry = _place_all(parts, self._ctx.unit_scale)
+        geometry.object_passes = [info for key, mesh in self._meshes.items() if mesh is not None
+                                  for info in self._passes[key]]
+        return geometry
 
     def _note(self, feature: str, object_name: str) -> None:
         names = self._noted.setdefault(feature, [])
@@ -204,6 +210,18 @@ def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
     return LocalMesh(vertices=vertices.astype(np.float64), triangles=triangles, normals=normals,
                      material_index=mat, attributes=attributes,
                      uv_name=None if uv_layer is None else uv_layer.name, texspace=texspace)
+
+
+def object_pass_info(ob) -> ObjectPassInfo:
+    """What render passes need of an object besides its Object Info (Cycles'
+    blender/object.cpp): its name, the name of its topmost parent (the Cryptomatte asset; its
+    own without a parent), whether its mesh has a UV map."""
+    root = ob
+    while root.parent is not None:
+        root = root.parent
+    uv_layers = getattr(ob.data, "uv_layers", None)
+    return ObjectPassInfo(name=ob.name, asset=root.name,
+                          has_uv=bool(uv_layers is not None and len(uv_layers)))
 
 
 def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names,

@@ -52,6 +52,7 @@ from .state import (
     CFG_SEED,
     CFG_SOBOL_MASK,
     PF_CAMERA,
+    PF_FIRST_SAMPLE,
     PF_MIS_SKIP,
     PF_TRANSPARENT_BG,
 )
@@ -268,7 +269,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.glossy[n] = 0
             st.transmission[n] = 0
             st.transparent[n] = 0
-            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG
+            st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | (PF_FIRST_SAMPLE if sample == 0 else 0)
             st.mis_pdf[n] = 0.0
             st.min_pdf[n] = math.inf
             st.self_prim[n] = -1

@@ -41,16 +41,35 @@ from .closures.layout import (
     CT_MICROFACET_REFRACTION,
     LABEL_DIFFUSE,
     LABEL_REFLECT,
+    LABEL_SINGULAR,
     LABEL_TRANSPARENT,
 )
 from .intersect import offset_origin
 from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
+from .passes import (
+    LK_BACKGROUND,
+    LK_SURFACE,
+    PC_DATA,
+    PC_DENOISE,
+    PC_LIGHT,
+    PC_SPLIT,
+    SK_DIRECT,
+    SK_INDIRECT,
+    background_passes,
+    light_pass,
+    shadow_pass,
+    singular_weights,
+    split_eval,
+    split_light,
+    surface_passes,
+)
 from .sampling import SET_BSDF, SET_LIGHT, SET_TERMINATE, bounce_set, sample_1d, sample_4d
 from .shading import (
     direct_light,
-    light_from_background,
     light_from_emitter,
     light_from_lamps,
+    light_from_suns,
+    light_from_world,
     next_path_flags,
     sample_direction,
     set_ray,
@@ -74,7 +93,9 @@ from .state import (
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     MF_EMISSIVE,
+    PF_DENOISE,
     PF_MIS_SKIP,
+    PF_SURFACE_PASS,
     PF_TERMINATE,
     PF_TRANSPARENT,
     PF_TRANSPARENT_BG,
@@ -87,9 +108,19 @@ from .surface import hit_distance, past_self_hit, surface_point
 
 # -- 3. shading ---------------------------------------------------------------------------------
 @kernel
-def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
-    """Shade the hits of the n live paths; returns the number of queued shadow rays."""
+def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
+    """Shade the hits of the n live paths; returns the number of queued shadow rays.
+
+    ``pd``, ``pb`` and ``fp`` are the render passes' settings, buffers and film
+    (``kernels.passes``); light that goes to Combined is handed to the light
+    passes right after it is added.
+    """
     n_shadow = 0
+    light_passes = pd.cfg[PC_LIGHT] != 0
+    split = pd.cfg[PC_SPLIT] != 0     # light split into diffuse/glossy/transmission
+    surface_pass_work = pd.cfg[PC_DATA] != 0 or pd.cfg[PC_DENOISE] != 0
+    r0 = g0 = b0 = 0.0
+    queued = 0
     n_lamps = sc.lamps.shape[0]
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
     mis = cfg[CFG_MIS] != 0
@@ -124,17 +155,30 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
 
         # -- light arriving along the ray ------------------------------------------------------
         if lamps_hit:
+            if light_passes:
+                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             passed = light_from_lamps(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i,
                                       ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
                                       mpx, mpy, mpz, mis_total, st.transparent[i], direct)
             if passed:
+                if light_passes:
+                    _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
                 st.transparent[i] += passed
                 if st.transparent[i] >= max_transparent:
                     continue   # Cycles: the path ends after the lamp's light
         if p < 0:
-            st.transparency[i] += light_from_background(
-                sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz, flags, mis_pdf,
-                pmf_mode, mpx, mpy, mpz, mis_total, direct)
+            if light_passes:
+                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+            st.transparency[i] += light_from_world(sc, cfg, fcfg, stats, st.radiance, i, st.beta,
+                                                   i, flags, direct)
+            if light_passes:
+                _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_BACKGROUND)
+                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+            light_from_suns(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz, flags,
+                            mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct)
+            if light_passes:
+                _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
+            background_passes(pd, fp, st.pixel[i], flags)
             continue
         if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
@@ -156,9 +200,13 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         # ray left (transparent surfaces may lie between).
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
+            if light_passes:
+                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
                                math.sqrt(hx * hx + hy * hy + hz * hz), sp.cos_o, flags, mis_pdf,
                                pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
+            if light_passes:
+                _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
         if terminate or res.n == 0:
             continue
         ncl = res.n
@@ -179,6 +227,14 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
                 st.beta[i, 1] /= q
                 st.beta[i, 2] /= q
 
+        # -- render passes written at the surface (data passes, denoising features) ------------
+        if surface_pass_work:
+            flags = surface_passes(pd, fp, st.pixel[i], flags, sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy,
+                                   sp.nsz, t_hit, p, b1, b2, m, scratch.cl, ncl, st.beta[i, 0],
+                                   st.beta[i, 1], st.beta[i, 2], res.tr, res.tg, res.tb,
+                                   -dx, -dy, -dz, pb, i)
+            st.flags[i] = flags
+
         # -- next-event estimation: one light --------------------------------------------------
         if nee:
             lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
@@ -192,9 +248,15 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
+            if split:
+                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+                queued = n_shadow
             n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
                                     scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
                                     True, 1.0, max_transparent - st.transparent[i])
+            if split:
+                _nee_passes(pd, fp, st, pb, i, scratch, ncl, -dx, -dy, -dz, bounce, flags,
+                            queued, n_shadow, r0, g0, b0)
 
         # -- BSDF sampling: the next ray ---------------------------------------------------------
         bu, bv, u_lobe, bw = sample_4d(sampler, key, bounce_set(vertex, SET_BSDF), mask)
@@ -212,7 +274,10 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
                 flags |= PF_TERMINATE
             st.flags[i] = flags
         else:
-            st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label), ds.label)
+            if split and bounce == 0:
+                _first_bounce_weights(pb, i, scratch.cl, ncl, -dx, -dy, -dz, ds)
+            st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label) | PF_SURFACE_PASS,
+                                       ds.label)
             st.mis_pdf[i] = ds.pdf
             st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
             if ds.pdf > 0.0:
@@ -224,6 +289,59 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats):
         st.self_prim[i] = p
         st.alive[i] = 1
     return n_shadow
+
+
+@device
+def _pass_light(pd, fp, st, pb, i, r0, g0, b0, kind):
+    """Hand the light path i added to Combined since its radiance was (r0, g0, b0) to the
+    light passes."""
+    r, g, b = st.radiance[i, 0] - r0, st.radiance[i, 1] - g0, st.radiance[i, 2] - b0
+    if r != 0.0 or g != 0.0 or b != 0.0:
+        light_pass(pd, fp, st.pixel[i], st.flags[i], st.bounce[i], pb, i, r, g, b, kind)
+
+
+@device
+def _nee_passes(pd, fp, st, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, queued, n_shadow,
+                r0, g0, b0):
+    """Pass weights of the light sample just taken at path i: the BSDF's own at the first
+    bounce (Cycles: direct light), else those of the first bounce.  Given to its shadow ray,
+    or used at once for a light that casts no shadow."""
+    if flags & PF_SURFACE_PASS:
+        w0, w1, w2, w3, w4, w5 = pb.pw[i, 0], pb.pw[i, 1], pb.pw[i, 2], pb.pw[i, 3], pb.pw[i, 4], \
+            pb.pw[i, 5]
+    else:
+        last = scratch.light
+        w0, w1, w2, w3, w4, w5 = split_eval(scratch.cl, ncl, wox, woy, woz, last[0], last[1],
+                                            last[2], int(last[3]))
+    if n_shadow > queued:
+        s = n_shadow - 1
+        pb.sw[s, 0], pb.sw[s, 1], pb.sw[s, 2] = w0, w1, w2
+        pb.sw[s, 3], pb.sw[s, 4], pb.sw[s, 5] = w3, w4, w5
+        pb.skind[s] = SK_DIRECT if bounce == 0 else SK_INDIRECT
+        return
+    r, g, b = st.radiance[i, 0] - r0, st.radiance[i, 1] - g0, st.radiance[i, 2] - b0
+    if r != 0.0 or g != 0.0 or b != 0.0:
+        split_light(pd, fp, st.pixel[i], bounce == 0, w0, w1, w2, w3, w4, w5, r, g, b)
+
+
+@device
+def _first_bounce_weights(pb, i, cl, ncl, wox, woy, woz, ds):
+    """Pass weights of path i's first scattering event (Cycles' pass_diffuse_weight and
+    pass_glossy_weight)."""
+    if ds.label & LABEL_SINGULAR:
+        w0, w1, w2, w3, w4, w5 = singular_weights(ds.label)
+    else:
+        w0, w1, w2, w3, w4, w5 = split_eval(cl, ncl, wox, woy, woz, ds.wix, ds.wiy, ds.wiz, 0)
+    pb.pw[i, 0], pb.pw[i, 1], pb.pw[i, 2] = w0, w1, w2
+    pb.pw[i, 3], pb.pw[i, 4], pb.pw[i, 5] = w3, w4, w5
+
+
+@kernel
+def start_denoising_features(n, st, pb):
+    """New camera paths look for their denoising albedo and normal."""
+    for i in range(n):
+        st.flags[i] |= PF_DENOISE
+        pb.dn[i, 0] = pb.dn[i, 1] = pb.dn[i, 2] = 1.0
 
 
 @device
@@ -267,22 +385,32 @@ def count_bounce(st, i, cfg, flags, label):
 
 
 @kernel
-def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n):
+def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, pb, fp):
     """Add unoccluded light, write finished paths to the film, compact the rest.
 
     Returns the number of live paths, now at the front of the state arrays.
     """
+    split = pd.cfg[PC_SPLIT] != 0    # shadow rays carry pass weights (``_nee_passes``)
     for s in range(n_shadow):
         if not occluded[s] and sq.alive[s]:
             i = sq.path[s]
             st.radiance[i, 0] += sq.contrib[s, 0]
             st.radiance[i, 1] += sq.contrib[s, 1]
             st.radiance[i, 2] += sq.contrib[s, 2]
+            if split:
+                shadow_pass(pd, fp, st.pixel[i], pb, s, sq.contrib[s, 0], sq.contrib[s, 1],
+                            sq.contrib[s, 2])
+    move_passes = pb.pw.shape[0] > 1
     m = 0
     for i in range(n):
         if st.alive[i]:
             if m != i:
                 _move(st, i, m)
+                if move_passes:
+                    for c in range(6):
+                        pb.pw[m, c] = pb.pw[i, c]
+                    for c in range(3):
+                        pb.dn[m, c] = pb.dn[i, c]
             m += 1
         else:
             _splat(st, i, film_sum, film_sq, film_n)
@@ -335,16 +463,19 @@ def splat_all(n, st, film_sum, film_sq, film_n):
         _splat(st, i, film_sum, film_sq, film_n)
 
 
-def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats):
+def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats, pd, pb, fp):
     """Trace spp samples for each pixel in ``pixels`` to completion.
 
-    ``film`` is ``(film_sum, film_sq, film_n)``.  A chunk always runs to the
+    ``film`` is ``(film_sum, film_sq, film_n)``; ``pd``, ``pb`` and ``fp`` are the
+    render passes' settings, buffers and film (``kernels.passes``).  A chunk always runs to the
     end (a fraction of a second): stopping paths half-way would keep the
     short paths and drop the long ones, a bias.  The loop ends when no path
     is alive; its bound guards against a path re-hitting its origin forever.
     """
     film_sum, film_sq, film_n = film
     n = generate_camera_rays(pixels, spp, film_n, st, sc, cfg)
+    if pd.cfg[PC_DENOISE]:
+        start_denoising_features(n, st, pb)
     stats[ST_CAMERA_RAYS] += n
     max_iterations = 4 * (int(cfg[CFG_MAX_BOUNCE]) + int(cfg[CFG_MAX_TRANSPARENT]) + 4)
     first = True
@@ -355,7 +486,7 @@ def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats)
             stats[ST_BOUNCE_RAYS] += n
         first = False
         prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n])
-        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats)
+        n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp)
         occluded = trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats)
-        n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n)
+        n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, pb, fp)
     splat_all(n, st, film_sum, film_sq, film_n)

@@ -202,19 +202,34 @@ def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, f
     ray (also through transparent surfaces) sees no background, and the
     pixel's alpha drops by its average throughput.
     """
+    transparency = light_from_world(sc, cfg, fcfg, stats, out, row, beta, i, flags, direct)
+    light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
+                    pmf_mode, mpx, mpy, mpz, mis_total, direct)
+    return transparency
+
+
+@device
+def light_from_world(sc, cfg, fcfg, stats, out, row, beta, i, flags, direct):
+    """The world's part of ``light_from_background`` (returns the film transparency)."""
     transparent_film = cfg[CFG_FILM_TRANSPARENT] != 0 and (flags & PF_TRANSPARENT_BG) != 0
     if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
         add_light(out, row, beta[i, 0] * sc.world[0], beta[i, 1] * sc.world[1],
                   beta[i, 2] * sc.world[2], direct, fcfg, stats)
+    if transparent_film:
+        return (beta[i, 0] + beta[i, 1] + beta[i, 2]) / 3.0
+    return 0.0
+
+
+@device
+def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf, pmf_mode,
+                    mpx, mpy, mpz, mis_total, direct):
+    """The suns' part of ``light_from_background``: suns with an angle seen by the ray."""
     if sc.lamps.shape[0] and cfg[CFG_LAMPS_HIT]:
         lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
                                mpx, mpy, mpz, mis_total)
         if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
                       stats)
-    if transparent_film:
-        return (beta[i, 0] + beta[i, 1] + beta[i, 2]) / 3.0
-    return 0.0
 
 
 @device
@@ -305,12 +320,16 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl,
     The light is added to ``out[row]`` at once if the light casts no shadow,
     else queued behind a shadow ray owned by ``row``; returns the queue length.
     With ``mis_on`` the power heuristic weighs it against BSDF sampling, whose
-    pdf is scaled by ``bsdf_pdf_scale`` (the number of BSDF rays per hit).
+    pdf is scaled by ``bsdf_pdf_scale`` (the number of BSDF rays per hit).  The
+    light's direction and the closure labels it excludes go to ``scratch.light`` (4,), for
+    render passes.
     """
     if pmf <= 0.0:
         return n_shadow
     ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
                       sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
+    scratch.light[0], scratch.light[1], scratch.light[2] = ls.wix, ls.wiy, ls.wiz
+    scratch.light[3] = ls.exclude
     lr, lg, lb = ls.lr, ls.lg, ls.lb
     if ls.tri >= 0 and (sc.mat_flags[sc.mat_index[ls.tri]] & MF_EMISSION_VARIES):
         er, eg, eb = emission_at(sc, scratch, ls.tri, ls.b1, ls.b2, ls.wix, ls.wiy, ls.wiz, ls.dist)

@@ -54,6 +54,7 @@ Scratch = namedtuple("Scratch", [
     "cl",                  # (MAX_CLOSURES, CL_STRIDE) f64  the closures of the point being shaded
     "cl_light",            # the same, for evaluating the emission of a light sample
     "regs",                # (R,) f64  the shader evaluator's registers (a copy of SceneData.svm_regs)
+    "light",               # (4,) f64  the last light sample: direction, excluded labels
 ])
 
 SceneData = namedtuple("SceneData", [
@@ -99,6 +100,11 @@ PF_TRANSMIT = 64
 PF_REFLECT = 128
 PF_TRANSPARENT = 256      # the path passed a transparent closure (Cycles' PATH_RAY_TRANSPARENT)
 PF_SHADOW = 512           # shading for a shadow ray (transparent shadows; Light Path's Is Shadow Ray)
+# Render passes (kernels.passes).
+PF_SURFACE_PASS = 1024    # scattered once: light goes to the diffuse/glossy/transmission passes
+PF_PASS_DONE = 2048       # normal and UV written for this sample (Cycles' PATH_RAY_SINGLE_PASS_DONE)
+PF_DENOISE = 4096         # denoising albedo and normal not written yet
+PF_FIRST_SAMPLE = 8192    # the pixel's first sample (depth, position, indices come from it)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -165,7 +171,8 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
 
 
 def alloc_scratch(sc: SceneData) -> Scratch:
-    """A worker's per-hit scratch space for scene ``sc`` (closures and shader registers)."""
+    """A worker's per-hit scratch space for scene ``sc`` (closures, shader registers and the
+    last light sample)."""
     return Scratch(cl=np.zeros((MAX_CLOSURES, CL_STRIDE)), cl_light=np.zeros((MAX_CLOSURES, CL_STRIDE)),
-                   regs=sc.svm_regs.copy())
+                   regs=sc.svm_regs.copy(), light=np.zeros(4))
 

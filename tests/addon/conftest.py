@@ -2,7 +2,7 @@
 
 * ``addon``: the add-on package (``mcengine_blender``, see ``helpers.load_addon``).
 * ``scene``: factory settings with an empty scene, the add-on registered,
-  "MC Engine" selected, a camera at the origin looking down -Z, 8x6 pixels.
+  "MC Engine" selected, a camera at the origin looking down -Z, 8x6 pixels, no denoising.
 * ``fake_session``: replaces the core's RenderSession by ``helpers.GradientSession``
   and returns the list of sessions created, so tests see the exported
   SceneDescription (``sessions[-1].desc``) and what the engine wrote.
@@ -29,6 +29,7 @@ def scene(addon):
     sc.render.engine = "MCENGINE"
     sc.render.resolution_x, sc.render.resolution_y = 8, 6
     sc.render.resolution_percentage = 100
+    sc.cycles.use_denoising = False   # on in the factory settings; tests that denoise say so
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     sc.collection.objects.link(cam)
     sc.camera = cam

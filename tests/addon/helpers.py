@@ -63,7 +63,8 @@ class GradientSession:
         self.target = np.stack([cols, rows, cols + 100 * rows, np.ones_like(rows)], axis=-1)
         self._image = np.zeros_like(self.target)
         self.samples_done = 0
-        self.stats = SimpleNamespace(rays_per_second=2.5e6, eta_seconds=3.0)
+        self.stats = SimpleNamespace(rays_per_second=2.5e6, eta_seconds=3.0,
+                                     metadata=lambda seconds, samples: {"samples": str(samples)})
         self.plan = pack_scene(desc).plan
         self.pass_images = []
 
@@ -80,6 +81,22 @@ class GradientSession:
 
     def image(self, bottom_up=False):
         return (self._image[::-1] if bottom_up else self._image).copy()
+
+    def pass_names(self):
+        return self.desc.passes.names()
+
+    def pass_image(self, name, bottom_up=False):
+        """Every render pass of the fake is a constant: its position in ``pass_names`` + 1."""
+        x0, y0, x1, y1 = self.desc.film.window
+        from mcengine.passes import BY_NAME, DENOISING_PASSES
+        info = BY_NAME.get(name) or next((p for p in DENOISING_PASSES if p.name == name), None)
+        channels = 4 if info is None else len(info.channels)
+        return np.full((y1 - y0, x1 - x0, channels), self.pass_names().index(name) + 1.0,
+                       np.float32)
+
+    def denoised(self, bottom_up=False):
+        """The fake's denoiser halves the image (None when denoising is off)."""
+        return self.image(bottom_up) * np.float32(0.5) if self.desc.denoising.enabled else None
 
 
 def export_scene(sessions):

@@ -91,10 +91,9 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
              "simulated: light sampling, lamp hits, MIS weights, caustic paths",
              "skipped: world lookups, transparent shadows"]
     assert scene.mcengine.last_effects == " | ".join(parts)
-    assert scene.mcengine.last_ignored == "denoising"
+    assert scene.mcengine.last_ignored == ""
     assert _panel_text(addon, scene) == [parts[0], "Simulated: " + parts[1][len("simulated: "):],
-                                         "Skipped: " + parts[2][len("skipped: "):],
-                                         "Ignored: denoising"]
+                                         "Skipped: " + parts[2][len("skipped: "):]]
 
 
 def _panel_text(addon, scene, operators=None, props=None):

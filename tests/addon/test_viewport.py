@@ -302,6 +302,7 @@ def test_view_update_and_view_draw_render_the_view(scene, addon, fake_session, d
     monkeypatch.setattr(addon.engine, "session_factory", gated_factory)
     scene.cycles.preview_samples = 8
     scene.camera.location = (0, 0, 5)
+    scene.cycles.use_denoising = bpy.context.view_layer.use_pass_z = True    # F12's, not the view's
     bpy.context.view_layer.update()
     engine = FakeEngine(addon)
     engine.view_update(None, Depsgraph())
@@ -317,6 +318,7 @@ def test_view_update_and_view_draw_render_the_view(scene, addon, fake_session, d
     assert engine.stats == "Sample 8/8" and engine.redraws == 1  # finished: no more redraws
     desc = fake_session[-1].desc
     assert desc.integrator.samples == 8 and (desc.film.width, desc.film.height) == (20, 15)
+    assert desc.passes.names() == [] and not desc.denoising.enabled     # Combined only
     np.testing.assert_allclose(desc.camera.matrix_world[:3, 3], (0, 0, 5), atol=1e-6)
     assert len(exports) == 1
     # Moving the view restarts the render without exporting; a material edit exports the

@@ -37,6 +37,10 @@ MAKE_SCENES = textwrap.dedent("""
     scene = bpy.context.scene
     scene.frame_current = 7
     bpy.ops.wm.save_as_mainfile(filepath=out + "/tiny.blend")
+    layer = scene.view_layers[0]
+    layer.use_pass_z = layer.use_pass_normal = layer.use_pass_cryptomatte_object = True
+    bpy.ops.wm.save_as_mainfile(filepath=out + "/passes.blend")
+    layer.use_pass_z = layer.use_pass_normal = layer.use_pass_cryptomatte_object = False
     bpy.data.objects.remove(bpy.data.objects["Camera"])
     bpy.ops.wm.save_as_mainfile(filepath=out + "/nocamera.blend")
 """)
@@ -241,6 +245,25 @@ def test_mcengine_render_writes_float_exr(scenes, tmp_path):
     assert rgba[..., :3].max() > 0.01
 
 
+def test_multilayer_exr_holds_the_passes_and_metadata(scenes, tmp_path):
+    from mcengine.imageio import read_exr_header, read_exr_layers
+    out = tmp_path / "layers.exr"
+    done = run_cli("render", scenes / "passes.blend", "--samples", "4", "--resolution", "16x12",
+                   "-F", "OPEN_EXR_MULTILAYER", "-o", out)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == [str(out)]
+    layers = read_exr_layers(out)
+    assert {"ViewLayer.Combined", "ViewLayer.Depth.Z", "ViewLayer.Normal.X",
+            "ViewLayer.CryptoObject02.r"} <= set(layers), sorted(layers)
+    assert layers["ViewLayer.Combined"].shape == (12, 16, 4)
+    depth = layers["ViewLayer.Depth.Z"]
+    assert 0 < depth.min() < 20 and depth.max() == np.float32(1e10)   # the cube and the sky
+    header = read_exr_header(out)
+    assert header["mcengine.ViewLayer.samples"] == "4"
+    manifests = [v for k, v in header.items() if k.startswith("cryptomatte/") and k.endswith("manifest")]
+    assert manifests and '"Cube"' in manifests[0]
+
+
 # ---------------------------------------------------------------------------
 # Helpers, in-process (no bpy)
 # ---------------------------------------------------------------------------
@@ -251,6 +274,8 @@ def test_mcengine_render_writes_float_exr(scenes, tmp_path):
     ("renders/", "PNG", 12, "{cwd}/renders/0012.png"),
     ("x.final", None, 1, "{cwd}/x.final.exr"),
     ("shot.EXR", "OPEN_EXR", 1, "{cwd}/shot.EXR"),
+    ("shot", "OPEN_EXR_MULTILAYER", 1, "{cwd}/shot.exr"),
+    ("shot.exr", "OPEN_EXR_MULTILAYER", 1, "{cwd}/shot.exr"),
 ])
 def test_output_paths_follow_blender(raw, fmt, frame, expected, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

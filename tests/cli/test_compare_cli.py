@@ -141,6 +141,8 @@ def test_compare_writes_every_file_and_exits_0_on_agree(tmp_path):
     assert report["verdict"] == "agree"
     assert report["settings"]["resolution"] == [32, 32]
     assert report["settings"]["seeds"] == {"mcengine": [1, 2], "cycles": [1, 2]}
+    # Denoising (on in most users' files) is turned off for both engines, and the report says so.
+    assert report["settings"]["denoising, adaptive sampling, clamping"] == "off"
     assert set(report["metrics"]) == {"relmse", "smape", "flip"}
     assert 0.0 <= report["metrics"]["flip"] < 1.0
     for engine in ("mcengine", "cycles"):
@@ -152,6 +154,7 @@ def test_compare_writes_every_file_and_exits_0_on_agree(tmp_path):
     assert width > 4 * 32 and height > 32
     markdown = (out / "report.md").read_text()
     assert "**Verdict: AGREE**" in markdown and "mean HDR-FLIP" in markdown
+    assert "denoising, adaptive sampling, clamping" in markdown
     from mcengine.imageio import read_exr
     for name in ("mcengine.exr", "cycles.exr"):
         image = read_exr(out / name)

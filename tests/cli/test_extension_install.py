@@ -34,8 +34,9 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 CORNELL_BOX = REPO / "blend_scenes" / "cornell_box.blend"
-BUNDLED = ["mcengine", "numba", "llvmlite", "embreex", "OpenEXR"]
-USED_BY_EVERY_RENDER = {"mcengine", "numba", "embreex"}
+BUNDLED = ["mcengine", "numba", "llvmlite", "embreex", "OpenEXR", "pyoidn", "cffi"]
+# The render denoises (Cycles' denoising settings), so Open Image Denoise loads too.
+USED_BY_EVERY_RENDER = {"mcengine", "numba", "embreex", "pyoidn"}
 RESOLUTION = 32
 SAMPLES = 4
 
@@ -61,6 +62,8 @@ CHILD = textwrap.dedent("""
     scene.render.resolution_x = scene.render.resolution_y = int(sys.argv[6])
     scene.render.resolution_percentage = 100
     scene.cycles.samples = int(sys.argv[7])
+    scene.cycles.use_denoising = True
+    scene.view_layers[0].cycles.use_denoising = True
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = out

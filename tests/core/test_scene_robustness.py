@@ -151,9 +151,12 @@ def test_memory_estimate_counts_what_a_render_allocates():
     film_arrays = sum(a.nbytes for a in session.film.arrays)
     assert memory.estimate(640 * 480, 0, 0).film == film_arrays + session.active.nbytes
     # bytes_for (used before allocating) equals what the two workers allocated for their
-    # paths; each worker also holds a scratch copy of the scene's closures and registers.
+    # paths (the film's one-element render-pass array aside: this render has no passes);
+    # each worker also holds a scratch copy of the scene's closures and registers.
     scratch = sum(a.nbytes for a in alloc_scratch(session.sc))
-    assert session.buffer_bytes - film_arrays == 2 * (_Buffers.bytes_for(session.batch_size, False) + scratch)
+    assert session.film.passes.nbytes == 8
+    assert session.buffer_bytes - film_arrays - 8 == 2 * (_Buffers.bytes_for(session.batch_size, False)
+                                                          + scratch)
 
 
 def test_film_read_out_is_exact_and_flips_without_copies():

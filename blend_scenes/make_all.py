@@ -39,6 +39,7 @@ SCENES = (
     "material_rough_glass",
     "caustics",
     "caustics_point",
+    "texture_procedural",
 )
 
 

@@ -50,6 +50,38 @@ DIST_ASHIKHMIN_SHIRLEY = 3
 DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_BECKMANN,
                  "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY}
 
+# Texture settings (codes are Cycles' enum values where it has them).
+DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
+NOISE_MULTIFRACTAL = 0
+NOISE_FBM = 1
+NOISE_HYBRID_MULTIFRACTAL = 2
+NOISE_RIDGED_MULTIFRACTAL = 3
+NOISE_HETERO_TERRAIN = 4
+NOISE_TYPES = {"MULTIFRACTAL": NOISE_MULTIFRACTAL, "FBM": NOISE_FBM,
+               "HYBRID_MULTIFRACTAL": NOISE_HYBRID_MULTIFRACTAL,
+               "RIDGED_MULTIFRACTAL": NOISE_RIDGED_MULTIFRACTAL,
+               "HETERO_TERRAIN": NOISE_HETERO_TERRAIN}
+VORONOI_F1 = 0
+VORONOI_F2 = 1
+VORONOI_SMOOTH_F1 = 2
+VORONOI_DISTANCE_TO_EDGE = 3
+VORONOI_N_SPHERE_RADIUS = 4
+VORONOI_FEATURES = {"F1": VORONOI_F1, "F2": VORONOI_F2, "SMOOTH_F1": VORONOI_SMOOTH_F1,
+                    "DISTANCE_TO_EDGE": VORONOI_DISTANCE_TO_EDGE,
+                    "N_SPHERE_RADIUS": VORONOI_N_SPHERE_RADIUS}
+EUCLIDEAN = 0
+MANHATTAN = 1
+CHEBYCHEV = 2
+MINKOWSKI = 3
+VORONOI_METRICS = {"EUCLIDEAN": EUCLIDEAN, "MANHATTAN": MANHATTAN, "CHEBYCHEV": CHEBYCHEV,
+                   "MINKOWSKI": MINKOWSKI}
+GRADIENT_TYPES = {"LINEAR": 0, "QUADRATIC": 1, "EASING": 2, "DIAGONAL": 3, "RADIAL": 4,
+                  "QUADRATIC_SPHERE": 5, "SPHERICAL": 6}
+WAVE_TYPES = {"BANDS": 0, "RINGS": 1}
+WAVE_BANDS_DIRECTIONS = {"X": 0, "Y": 1, "Z": 2, "DIAGONAL": 3}
+WAVE_RINGS_DIRECTIONS = {"X": 0, "Y": 1, "Z": 2, "SPHERICAL": 3}
+WAVE_PROFILES = {"SIN": 0, "SAW": 1, "TRI": 2}
+
 # Enum properties: property name -> {Blender's identifier: code}.  A node's enum inputs
 # ("prop:<name>") are encoded with the table of that name.
 # Operations of the Math and Vector Math nodes (one ``operation`` property, one table: the
@@ -83,6 +115,16 @@ ENUMS = {
     "clamp_type": CLAMP_TYPES,
     "mode": COLOR_MODES,
     "vector_type": VECTOR_TYPES,
+    "noise_dimensions": DIMENSIONS,
+    "noise_type": NOISE_TYPES,
+    "voronoi_dimensions": DIMENSIONS,
+    "feature": VORONOI_FEATURES,
+    "distance": VORONOI_METRICS,
+    "gradient_type": GRADIENT_TYPES,
+    "wave_type": WAVE_TYPES,
+    "bands_direction": WAVE_BANDS_DIRECTIONS,
+    "rings_direction": WAVE_RINGS_DIRECTIONS,
+    "wave_profile": WAVE_PROFILES,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -209,6 +251,36 @@ VALUE_NODES = {
     "TexChecker": NodeSpec(401, (_v("Vector", GENERATED), _c("Color1", (0.8, 0.8, 0.8)),
                                  _c("Color2", (0.2, 0.2, 0.2)), _f("Scale", 5.0)),
                            (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    "TexWhiteNoise": NodeSpec(402, (_v("Vector", (0, 0, 0)), _f("W", 0.0), _p("noise_dimensions", 3)),
+                              (_f("Value", 0.0), _c("Color", (0, 0, 0))), True),
+    "TexNoise": NodeSpec(403, (
+        _v("Vector", GENERATED), _f("W", 0.0), _f("Scale", 5.0), _f("Detail", 2.0),
+        _f("Roughness", 0.5), _f("Lacunarity", 2.0), _f("Offset", 0.0), _f("Gain", 1.0),
+        _f("Distortion", 0.0), _p("noise_dimensions", 3), _p("noise_type", NOISE_FBM),
+        _p("normalize", 1)), (_f("Fac", 0.0), _c("Color", (0, 0, 0))), True),
+    "TexVoronoi": NodeSpec(404, (
+        _v("Vector", GENERATED), _f("W", 0.0), _f("Scale", 5.0), _f("Detail", 0.0),
+        _f("Roughness", 0.5), _f("Lacunarity", 2.0), _f("Smoothness", 1.0), _f("Exponent", 0.5),
+        _f("Randomness", 1.0), _p("voronoi_dimensions", 3), _p("feature", VORONOI_F1),
+        _p("distance", EUCLIDEAN), _p("normalize", 0)),
+        (_f("Distance", 0.0), _c("Color", (0, 0, 0)), _v("Position"), _f("W", 0.0),
+         _f("Radius", 0.0)), True),
+    "TexGradient": NodeSpec(405, (_v("Vector", GENERATED), _p("gradient_type", 0)),
+                            (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    "TexWave": NodeSpec(406, (
+        _v("Vector", GENERATED), _f("Scale", 5.0), _f("Distortion", 0.0), _f("Detail", 2.0),
+        _f("Detail Scale", 1.0), _f("Detail Roughness", 0.5), _f("Phase Offset", 0.0),
+        _p("wave_type", 0), _p("bands_direction", 0), _p("rings_direction", 0),
+        _p("wave_profile", 0)), (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    "TexBrick": NodeSpec(407, (
+        _v("Vector", GENERATED), _c("Color1", (0.8, 0.8, 0.8)), _c("Color2", (0.2, 0.2, 0.2)),
+        _c("Mortar", (0, 0, 0)), _f("Scale", 5.0), _f("Mortar Size", 0.02),
+        _f("Mortar Smooth", 0.1), _f("Bias", 0.0), _f("Brick Width", 0.5), _f("Row Height", 0.25),
+        _p("offset", 0.5), _p("offset_frequency", 2), _p("squash", 1.0),
+        _p("squash_frequency", 2)), (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    "TexMagic": NodeSpec(408, (_v("Vector", GENERATED), _f("Scale", 5.0), _f("Distortion", 1.0),
+                               _p("turbulence_depth", 2)),
+                         (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),

@@ -116,8 +116,9 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     film = scene.film
     camera = pack_camera(scene.camera, film)
     none_f, none_i = np.zeros(0), np.zeros(0, np.int32)
+    normals = np.ascontiguousarray(g.normals, np.float32)
     sc = SceneData(
-        verts=verts, tris=tris, normals=np.ascontiguousarray(g.normals, np.float32),
+        verts=verts, tris=tris, normals=normals,
         mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
@@ -125,7 +126,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         tri_area=tri_area, tri_normal=tri_normal,
         world=np.asarray(scene.world.color, np.float64).reshape(3), camera=camera,
         filter_table=filter_table(film.filter_type, film.filter_width),
-        tex=TextureData(attr=attr, tri_object=np.ascontiguousarray(g.object_index, np.int32),
+        tex=TextureData(attr=attr, normals=normals, tri_object=np.ascontiguousarray(g.object_index, np.int32),
                         objects=pack_objects(g), camera=camera))
 
     # Lights: lamps, and the triangles of emissive materials.

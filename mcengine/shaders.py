@@ -66,6 +66,7 @@ from .kernels.svm.nodes import (
     SHADER_ROUTING,
     SIZE,
     TABLE,
+    TANGENT_PREFIX,
     VALUE_NODES,
     VECTOR,
 )
@@ -264,7 +265,7 @@ class _Compiler:
     def evaluate(self, node, spec) -> dict:
         """Compile value node ``node`` (or fold it); its outputs by name."""
         values = [self.input(node, socket) for socket in spec.inputs]
-        if node.type == "Attribute" or node.type == "UVMap":
+        if node.type in _ATTRIBUTE_READERS:
             values = self.attribute_inputs(node, spec, values)
         if spec.pure and all(v.constant for v in values):
             return self.fold(spec, values)
@@ -278,9 +279,9 @@ class _Compiler:
         return outputs
 
     def attribute_inputs(self, node, spec, values) -> list:
-        """The attribute a UV Map or Attribute node reads, found by name."""
-        name = str(node.props.get("attribute_name" if node.type == "Attribute" else "uv_map", ""))
-        offset, size = self.attributes.find(name)
+        """The attribute a UV Map, Attribute or Normal Map node reads, found by name."""
+        prefix, prop = _ATTRIBUTE_READERS[node.type]
+        offset, size = self.attributes.find(prefix + str(node.props.get(prop, "")))
         names = [s.name for s in spec.inputs]
         values[names.index("prop:attribute")] = Value(FLOAT, (float(offset),))
         if "prop:attribute_size" in names:
@@ -336,10 +337,17 @@ class _Compiler:
         return Value(to, reg=out)
 
 
+# Nodes that read a per-corner attribute: type -> (prefix of the attribute's name, the
+# property naming it); the attribute's offset goes to their "prop:attribute" input.
+_ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map"),
+                      "NormalMap": (TANGENT_PREFIX, "uv_map")}
+
+
 # What the compiler shows a node it evaluates ahead of time: no point, no scene.
 _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
                           False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0)
-_NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), tri_object=np.zeros(0, np.int32),
+_NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
+                           tri_object=np.zeros(0, np.int32),
                            objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS))
 
 

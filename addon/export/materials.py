@@ -57,6 +57,12 @@ class MaterialTable:
         return {str(node.props.get("attribute_name", "")) for m in self.materials
                 for node in m.nodes if node.type == "Attribute"}
 
+    def tangent_maps(self, indices) -> set:
+        """UV maps whose tangents the materials at ``indices`` read (Normal Map nodes in
+        tangent space; "" is the default UV map)."""
+        return {str(node.props.get("uv_map", "")) for i in set(indices) for node in self.materials[i].nodes
+                if node.type == "NormalMap" and str(node.props.get("space", "TANGENT")) == "TANGENT"}
+
     def index(self, material) -> int:
         """Index of a Blender material (None: the default surface), converting it once."""
         key = None if material is None else material.name_full

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
 
 __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances"]
@@ -40,6 +41,8 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "holdout/shadow catcher": "these objects render as normal objects",
+    "normal maps without a UV map": "their normal maps leave the normal unchanged (Cycles takes "
+                                    "tangents from generated coordinates there)",
 }
 # Object.visible_* flags Cycles uses for meshes.
 _RAYS = ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")
@@ -64,6 +67,7 @@ class LocalMesh:
                     the other attributes the materials read
     uv_name         name of the default (active render) UV map in ``attributes``, or None
     texspace        (2, 3) float64  generated texture space: centre and half-size
+    tangents_failed why tangents some Normal Map reads are missing ("" if none are)
 
     Per-corner values are gathered block by block when the instances are placed,
     never as whole (T, 3, C) arrays; without a UV map the exported UVs stay
@@ -77,6 +81,7 @@ class LocalMesh:
     attributes: dict
     uv_name: str | None
     texspace: np.ndarray
+    tangents_failed: str = ""
 
 
 @dataclass
@@ -138,7 +143,11 @@ class MeshCollector:
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
-            self._meshes[key] = read_local_mesh(ob, slots, self._materials.attribute_names())
+            self._meshes[key] = read_local_mesh(ob, slots, self._materials.attribute_names(),
+                                                self._materials.tangent_maps(slots or (0,)))
+            mesh = self._meshes[key]
+            if mesh is not None and mesh.tangents_failed:
+                self._note(mesh.tangents_failed, ob.name)
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
             self._passes[key] = []
         if self._meshes[key] is not None:
@@ -169,7 +178,7 @@ class MeshCollector:
             names.append(object_name)
 
 
-def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
+def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | None:
     """Read an evaluated object's mesh in object space (None if it has no triangles).
 
     Parameters
@@ -181,6 +190,8 @@ def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
     wanted : collection of str
         Names of generic attributes some material reads (UV maps and colour
         attributes are always read).
+    tangents : collection of str
+        UV maps ("" the default one) whose MikkTSpace tangents some Normal Map reads.
     """
     me = ob.to_mesh()
     try:
@@ -199,6 +210,7 @@ def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
         uv_layer = _render_uv_layer(me)
         slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
+        tangents_failed = _add_tangents(me, triangles, normals, tangents, uv_layer, attributes)
         texspace = _texspace(ob)
     finally:
         ob.to_mesh_clear()
@@ -209,7 +221,8 @@ def read_local_mesh(ob, slot_materials, wanted=()) -> LocalMesh | None:
         mat = np.zeros(t, np.int32)
     return LocalMesh(vertices=vertices.astype(np.float64), triangles=triangles, normals=normals,
                      material_index=mat, attributes=attributes,
-                     uv_name=None if uv_layer is None else uv_layer.name, texspace=texspace)
+                     uv_name=None if uv_layer is None else uv_layer.name, texspace=texspace,
+                     tangents_failed=tangents_failed)
 
 
 def object_pass_info(ob) -> ObjectPassInfo:
@@ -458,6 +471,59 @@ def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
         values = _get(attr.data, field_name, np.float32, count * size).reshape(count, size)
         out[name] = CornerTable(values, domain)
     return out
+
+
+def _add_tangents(me, triangles, normals, maps, default_layer, attributes) -> str:
+    """Add the MikkTSpace tangent and sign of each UV map in ``maps`` ("" the default map)
+    to ``attributes`` as ``tangent:<map>`` (4 components, object space, per corner).
+
+    Cycles runs MikkTSpace on the triangles (``loop_triangles``), with the mesh's shading
+    normals (flat faces: each triangle's own normal), so the tangents are those Blender's
+    ``Mesh.calc_tangents`` computes for a mesh of those triangles; on a mesh of quads it
+    would pair the triangles differently.  Returns what went wrong, for a note: "" when
+    nothing did, or "normal maps without a UV map" (Cycles then takes tangents from the
+    generated coordinates).  A named map the mesh lacks is left out, as in Cycles (the
+    normal stays unchanged)."""
+    layers = {}
+    for name in maps:
+        layer = default_layer if name == "" else me.uv_layers.get(name)
+        if layer is None:
+            if name == "":
+                return "normal maps without a UV map"
+            continue
+        layers[name] = attributes[layer.name]
+    if not layers:
+        return ""
+    t = len(triangles)
+    corner_normals = normals.corners(0, t).reshape(-1, 3)
+    if me.normals_domain == "FACE":
+        co = _get(me.vertices, "co", np.float32, len(me.vertices) * 3).reshape(-1, 3).astype(np.float64)
+        p = co[triangles]
+        flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-30)
+        corner_normals = np.repeat(flat, 3, axis=0)
+    tm = bpy.data.meshes.new(".mcengine tangents")
+    try:
+        tm.vertices.add(len(me.vertices))
+        tm.vertices.foreach_set("co", _get(me.vertices, "co", np.float32, len(me.vertices) * 3))
+        tm.loops.add(3 * t)
+        tm.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, np.int32).ravel())
+        tm.polygons.add(t)
+        tm.polygons.foreach_set("loop_start", np.arange(0, 3 * t, 3, dtype=np.int32))
+        tm.update(calc_edges=True)
+        tm.normals_split_custom_set(np.asarray(corner_normals, np.float32).tolist())
+        for k, (name, table) in enumerate(layers.items()):
+            # A layer per map: Blender keeps the tangents it computed for a layer's name.
+            uv = tm.uv_layers.new(name=f"uv{k}")
+            uv.uv.foreach_set("vector", np.ascontiguousarray(table.corners(0, t), np.float32).ravel())
+            tm.calc_tangents(uvmap=uv.name)
+            values = np.empty((3 * t, 4), np.float32)
+            values[:, :3] = _get(tm.loops, "tangent", np.float32, 9 * t).reshape(-1, 3)
+            values[:, 3] = _get(tm.loops, "bitangent_sign", np.float32, 3 * t)
+            attributes[TANGENT_PREFIX + name] = CornerTable(values, np.arange(3 * t).reshape(t, 3))
+    finally:
+        bpy.data.meshes.remove(tm)
+    return ""
 
 
 def _texspace(ob) -> np.ndarray:

@@ -142,9 +142,9 @@ def count_mesh_reads(addon, monkeypatch):
     calls = []
     real = addon.export.mesh.read_local_mesh
 
-    def counting(ob, slots, wanted=()):
+    def counting(ob, slots, wanted=(), tangents=()):
         calls.append(ob.name)
-        return real(ob, slots, wanted)
+        return real(ob, slots, wanted, tangents)
 
     monkeypatch.setattr(addon.export.mesh, "read_local_mesh", counting)
     return calls
@@ -253,10 +253,10 @@ def test_one_failing_object_is_skipped_with_a_warning(scene, fake_session, addon
     new_mesh_object("Bad", TRI, [(0, 1, 2)]).location = (5, 0, 0)
     real = addon.export.mesh.read_local_mesh
 
-    def failing(ob, slots, wanted=()):
+    def failing(ob, slots, wanted=(), tangents=()):
         if ob.name == "Bad":
             raise ValueError("broken mesh")
-        return real(ob, slots, wanted)
+        return real(ob, slots, wanted, tangents)
 
     monkeypatch.setattr(addon.export.mesh, "read_local_mesh", failing)
     desc = export_scene(fake_session)
@@ -346,3 +346,50 @@ def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, a
     np.testing.assert_array_equal(g.uvs[:grid_tris], g.attributes["Second"][:grid_tris])
     assert not np.any(g.uvs[grid_tris:]) and not any(np.any(a[grid_tris:]) for a in g.attributes.values())
     np.testing.assert_array_equal(g.object_info[-1, 1], 3.0)
+
+
+def _normal_map_material(uv_map=""):
+    mat = bpy.data.materials.new("Bumpy")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    node = nt.nodes.new("ShaderNodeNormalMap")
+    node.uv_map = uv_map
+    nt.links.new(node.outputs["Normal"], nt.nodes["Principled BSDF"].inputs["Normal"])
+    return mat
+
+
+def test_normal_maps_get_the_tangents_of_their_uv_map(scene, fake_session):
+    """Only UV maps a Normal Map reads get tangents: Blender's MikkTSpace ones, object space."""
+    ob = new_mesh_object("Quad", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+    ob.rotation_euler = (0, 0, 1.0)      # world space would turn the tangent
+    plain = ob.data.uv_layers.new(name="Plain")
+    plain.uv.foreach_set("vector", [0, 0, 1, 0, 1, 1, 0, 1])          # u along +x
+    turned = ob.data.uv_layers.new(name="Turned")
+    turned.uv.foreach_set("vector", [0, 0, 0, 1, 1, 1, 1, 0])        # u along +y
+    ob.data.materials.append(_normal_map_material("Turned"))
+    g = export_scene(fake_session).geometry
+    assert "tangent:Turned" in g.attributes and "tangent:" not in g.attributes
+    tangent = g.attributes["tangent:Turned"].reshape(-1, 4)
+    np.testing.assert_allclose(tangent[:, :3], [(0, 1, 0)] * len(tangent), atol=1e-6)
+    np.testing.assert_allclose(np.abs(tangent[:, 3]), 1.0)
+
+
+def test_normal_maps_on_ngons_get_tangents(scene, fake_session):
+    """Tangents come from the triangles, so n-gons (which calc_tangents refuses) have them."""
+    ring = [(math.cos(a), math.sin(a), 0) for a in np.linspace(0, 2 * math.pi, 7)[:-1]]
+    ob = new_mesh_object("Hexagon", ring, [tuple(range(6))])
+    layer = ob.data.uv_layers.new(name="UV")
+    layer.uv.foreach_set("vector", np.array(ring)[:, :2].ravel() * 0.5)   # u along +x
+    ob.data.materials.append(_normal_map_material())
+    desc = export_scene(fake_session)
+    tangent = desc.geometry.attributes["tangent:"].reshape(-1, 4)
+    np.testing.assert_allclose(tangent[:, :3], [(1, 0, 0)] * 12, atol=1e-6)
+    assert not any("tangent" in w or "normal map" in w for w in desc.warnings)
+
+
+def test_normal_maps_without_a_uv_map_are_warned(scene, fake_session):
+    ob = new_mesh_object("Bare", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+    ob.data.materials.append(_normal_map_material())
+    desc = export_scene(fake_session)
+    assert "tangent:" not in desc.geometry.attributes
+    assert any("without a UV map" in w and "Bare" in w for w in desc.warnings)

@@ -25,6 +25,9 @@ attributes, a rotation, ...).
 """
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -87,11 +90,42 @@ def _scene(cases: dict):
     return scene, rows, cols
 
 
+_WARM_UP = """
+import bpy
+from mcengine_blender.batch.render import ensure_registered
+from tests.nodes.harness import _scene
+ensure_registered()
+scene, _rows, _cols = _scene({"warm up": lambda nt: nt.nodes.new("ShaderNodeTexChecker").outputs["Color"]})
+scene.render.engine = "MCENGINE"
+bpy.ops.render.render()
+"""
+
+
+def compile_kernels_apart() -> None:
+    """Compile the kernels (into numba's disk cache) in a separate process, by an MC Engine
+    render of a textured plane there.
+
+    With a cold cache, numba compiling in a process where Cycles has rendered crashed
+    (a segfault inside bpy.ops.render.render, every time); loading the cached kernels
+    does not.  Once per test process; a few seconds when the cache is warm.
+    """
+    global _compiled
+    if not _compiled:
+        root = Path(__file__).resolve().parents[2]
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(root), os.environ.get("PYTHONPATH")]))}
+        subprocess.run([sys.executable, "-c", _WARM_UP], cwd=root, env=env, check=True)
+        _compiled = True
+
+
+_compiled = False
+
+
 def render_cases(cases: dict) -> dict:
     """Render the cases with Cycles and MC Engine: name -> (cycles, mcengine) images."""
     import bpy
 
     from mcengine_blender.batch.render import ensure_registered
+    compile_kernels_apart()
     ensure_registered()
     out = {}
     names = list(cases)

@@ -46,7 +46,8 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
 )
 from .input_nodes import eval_input_node
 from .math_nodes import eval_math_node
-from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_TEXTURE, FAMILY_VECTOR
+from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_NORMAL, FAMILY_TEXTURE, FAMILY_VECTOR
+from .normal_nodes import eval_normal_node
 from .texture_nodes import eval_texture_node
 from .vector_nodes import eval_vector_node
 
@@ -83,6 +84,8 @@ def eval_node(code, regs, b, c, sd, tex):
         eval_texture_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_VECTOR:
         eval_vector_node(code, regs, b, c, sd, tex)
+    elif family == FAMILY_NORMAL:
+        eval_normal_node(code, regs, b, c, sd, tex)
 
 
 @device

@@ -30,6 +30,7 @@ ShadingData = namedtuple("ShadingData", [
 
 TextureData = namedtuple("TextureData", [
     "attr",                    # (T, 3, S) f32  per-corner attributes (``ATTR_*`` layout, shaders.py)
+    "normals",                 # (T, 3, 3) f32  world shading normals at the corners (SceneData.normals)
     "tri_object",              # (T,) int32     object of each triangle
     "objects",                 # (O, OBJ_STRIDE) f64  per-object data (OBJ_* columns)
     "camera",                  # (CAMERA_PARAMS,) f64  the camera (Camera and Window coordinates)

@@ -107,6 +107,15 @@ COLOR_MODES = {"RGB": 0, "HSV": 1, "HSL": 2}
 # ``vector_type``: Mapping (all four), Vector Transform (POINT, VECTOR, NORMAL).
 VECTOR_TYPES = {"POINT": 0, "TEXTURE": 1, "VECTOR": 2, "NORMAL": 3}
 
+# Normal Map's ``space`` (Displacement nodes use the same identifiers).
+SPACE_TANGENT = 0
+SPACE_OBJECT = 1
+SPACE_WORLD = 2
+SPACE_BLENDER_OBJECT = 3
+SPACE_BLENDER_WORLD = 4
+SPACES = {"TANGENT": SPACE_TANGENT, "OBJECT": SPACE_OBJECT, "WORLD": SPACE_WORLD,
+          "BLENDER_OBJECT": SPACE_BLENDER_OBJECT, "BLENDER_WORLD": SPACE_BLENDER_WORLD}
+
 ENUMS = {
     "distribution": DISTRIBUTIONS,
     "operation": OPERATIONS,
@@ -125,6 +134,7 @@ ENUMS = {
     "bands_direction": WAVE_BANDS_DIRECTIONS,
     "rings_direction": WAVE_RINGS_DIRECTIONS,
     "wave_profile": WAVE_PROFILES,
+    "space": SPACES,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -203,7 +213,8 @@ FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, 
 FAMILY_MATH = 2        # svm/math_nodes.py: Math, Vector Math, Map Range, converters
 FAMILY_COLOR = 3       # svm/color_nodes.py: Mix, ColorRamp, curves, colour adjustments
 FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural and image textures
-FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Normal Map, Bump, Vector Transform
+FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Transform
+FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump
 
 # Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
 # of the single-output coordinate nodes the compiler inserts for implicit inputs).
@@ -284,7 +295,14 @@ VALUE_NODES = {
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
+    # -- normal family ("prop:attribute": the tangent attribute "tangent:<uv map>", see
+    #    TANGENT_PREFIX; its 4 components are the MikkTSpace tangent and sign, object space)
+    "NormalMap": NodeSpec(601, (_f("Strength", 1.0), _c("Color", (0.5, 0.5, 1.0)), _p("space", SPACE_TANGENT),
+                                _p("attribute", -1)), (_v("Normal", UNLINKED),), False),
 }
+
+# Name of the per-corner tangent attribute of a UV map ("" is the default UV map).
+TANGENT_PREFIX = "tangent:"
 
 NODES = {**CLOSURES, **VALUE_NODES}
 KIND = {name: spec.code for name, spec in CLOSURES.items()}

@@ -14,7 +14,7 @@ WIDTH, HEIGHT = 32, 24
 SAMPLES = 16
 
 
-def _plane_under_sun(scene, texture=False):
+def _plane_under_sun(scene, unsupported=False):
     """A grey plane filling the camera's view, lit by a sun, with a dim world."""
     mesh = bpy.data.meshes.new("Plane")
     s = 4.0
@@ -25,12 +25,10 @@ def _plane_under_sun(scene, texture=False):
     bsdf = tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.6, 0.6, 0.6, 1.0)
     bsdf.inputs["Specular IOR Level"].default_value = 0.0
-    if texture:  # MC Engine ignores textures: its plane stays uniform grey
-        checker = tree.nodes.new("ShaderNodeTexChecker")
-        checker.inputs["Scale"].default_value = 2.0
-        checker.inputs["Color1"].default_value = (0.9, 0.9, 0.9, 1.0)
-        checker.inputs["Color2"].default_value = (0.05, 0.05, 0.05, 1.0)
-        tree.links.new(checker.outputs["Color"], bsdf.inputs["Base Color"])
+    if unsupported:  # MC Engine ignores the Wireframe node: its plane stays uniform grey
+        wire = tree.nodes.new("ShaderNodeWireframe")
+        wire.inputs["Size"].default_value = 0.5
+        tree.links.new(wire.outputs["Fac"], bsdf.inputs["Base Color"])
     mesh.materials.append(material)
     scene.collection.objects.link(bpy.data.objects.new("Plane", mesh))
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
@@ -91,11 +89,11 @@ def test_compares_the_unsaved_scene_and_shows_the_verdict(scene, tmp_path, capfd
 
 
 def test_a_difference_is_a_warning_naming_what_mc_engine_ignored(scene, tmp_path, capfd):
-    _plane_under_sun(scene, texture=True)
+    _plane_under_sun(scene, unsupported=True)
     assert _compare(tmp_path) == {"FINISHED"}
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["verdict"] == "differ"
-    assert any("textures" in note for note in report["notes"])
+    assert any("Wireframe" in note for note in report["notes"])
     out, err = capfd.readouterr()
     assert "Warning: Compare with Cycles: Scene: differ" in out + err
 

@@ -148,7 +148,9 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 c = math.cos(0.5 * float(li.spot_size))
                 row[L_SPOT_COS] = c
                 blend = float(li.spot_blend)
-                row[L_SPOT_SMOOTH] = 1.0 / ((1.0 - c) * blend) if blend > 0.0 and c < 1.0 else 0.0
+                # (1 - c) * blend may underflow to 0 for tiny blends and cones (1 / that: inf).
+                smooth_width = (1.0 - c) * blend
+                row[L_SPOT_SMOOTH] = 1.0 / smooth_width if smooth_width > 0.0 else 0.0
                 inv = np.linalg.inv(m[:3, :3]) if abs(np.linalg.det(m[:3, :3])) > 0 else np.eye(3)
                 row[L_SPOT_INV:L_SPOT_INV + 9] = inv.reshape(-1)
                 # The cone holds (1 - c)/2 of the sphere's directions at most.

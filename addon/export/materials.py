@@ -27,7 +27,7 @@ import math
 from mcengine.kernels.svm.nodes import Socket
 from mcengine.scene import Link, Material, ShaderNode
 
-from .shader_graph import GraphReader, label
+from .shader_graph import GraphReader, label, source
 
 __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node", "clamp_color", "fmt"]
 
@@ -200,33 +200,11 @@ def _conductor_fresnel(cos_i, n, k) -> float:
     return 0.5 * (rs + rp)
 
 
-def linked_socket(socket):
-    """The output socket feeding ``socket`` through reroutes, unmuted links and muted
-    nodes (which pass their first matching input through, as in Blender), or None."""
-    for _ in range(256):
-        if not socket.is_linked:
-            return None
-        links = [link for link in socket.links if not link.is_muted]
-        if not links:
-            return None
-        source = links[0].from_socket
-        node = source.node
-        if node.bl_idname == "NodeReroute":
-            socket = node.inputs[0]
-        elif node.mute:
-            through = [lk.from_socket for lk in node.internal_links if lk.to_socket == source]
-            if not through:
-                return None
-            socket = through[0]
-        else:
-            return source
-    return None
-
-
 def linked_node(socket):
-    """The node feeding ``socket`` (see :func:`linked_socket`), or None."""
-    source = linked_socket(socket)
-    return source.node if source is not None else None
+    """The node feeding ``socket`` (through reroutes, muted nodes and links and node groups,
+    as :func:`shader_graph.source` follows them), or None."""
+    out, _groups = source(socket)
+    return out.node if out is not None else None
 
 
 def clamp_color(values) -> tuple:

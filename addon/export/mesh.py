@@ -210,7 +210,8 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         uv_layer = _render_uv_layer(me)
         slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
-        tangents_failed = _add_tangents(me, triangles, normals, tangents, uv_layer, attributes)
+        tangents_failed = _add_tangents(me, vertices, triangles, normals, tangents, uv_layer,
+                                        attributes)
         texspace = _texspace(ob)
     finally:
         ob.to_mesh_clear()
@@ -473,7 +474,7 @@ def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
     return out
 
 
-def _add_tangents(me, triangles, normals, maps, default_layer, attributes) -> str:
+def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attributes) -> str:
     """Add the MikkTSpace tangent and sign of each UV map in ``maps`` ("" the default map)
     to ``attributes`` as ``tangent:<map>`` (4 components, object space, per corner).
 
@@ -497,15 +498,14 @@ def _add_tangents(me, triangles, normals, maps, default_layer, attributes) -> st
     t = len(triangles)
     corner_normals = normals.corners(0, t).reshape(-1, 3)
     if me.normals_domain == "FACE":
-        co = _get(me.vertices, "co", np.float32, len(me.vertices) * 3).reshape(-1, 3).astype(np.float64)
-        p = co[triangles]
+        p = vertices.astype(np.float64)[triangles]
         flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
         flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-30)
         corner_normals = np.repeat(flat, 3, axis=0)
     tm = bpy.data.meshes.new(".mcengine tangents")
     try:
-        tm.vertices.add(len(me.vertices))
-        tm.vertices.foreach_set("co", _get(me.vertices, "co", np.float32, len(me.vertices) * 3))
+        tm.vertices.add(len(vertices))
+        tm.vertices.foreach_set("co", np.ascontiguousarray(vertices, np.float32).ravel())
         tm.loops.add(3 * t)
         tm.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, np.int32).ravel())
         tm.polygons.add(t)

@@ -29,7 +29,7 @@ import numpy as np
 from mcengine.kernels.svm.nodes import NODES, SHADER_ROUTING
 from mcengine.scene import Link, ShaderNode
 
-__all__ = ["GraphReader", "label", "node_type", "SPECIAL_PROPS"]
+__all__ = ["GraphReader", "label", "node_type", "source", "SPECIAL_PROPS"]
 
 # Blender's node idnames are "ShaderNode" + the core's type, except these.
 _ALIASES = {"BsdfAnisotropic": "BsdfGlossy"}
@@ -93,47 +93,9 @@ class GraphReader:
         if fallback and fallback not in self.fallbacks:
             self.fallbacks.append(fallback)
 
-    # -- following links --------------------------------------------------------------------------
-    def source(self, socket, groups=()):
-        """What an input socket receives: (output socket, group path) of a real node, or
-        (None, value) with the constant it gets (None: nothing at all)."""
-        for _ in range(1024):
-            links = [link for link in socket.links if _carries(link)] if socket.is_linked else []
-            if not links:
-                value = getattr(socket, "default_value", None)
-                return None, value
-            out = links[0].from_socket
-            node = out.node
-            if node.bl_idname == "NodeReroute":
-                socket = node.inputs[0]
-            elif node.mute:
-                through = [lk.from_socket for lk in node.internal_links if lk.to_socket == out]
-                if not through:
-                    return None, None
-                socket = through[0]
-            elif node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
-                inner = _group_output(node.node_tree)
-                if inner is None:
-                    return None, None
-                target = _by_identifier(inner.inputs, out.identifier)
-                if target is None:
-                    return None, None
-                socket, groups = target, groups + (node,)
-            elif node.bl_idname == "NodeGroupInput":
-                if not groups:
-                    return None, None
-                outer = groups[-1]
-                target = _by_identifier(outer.inputs, out.identifier)
-                if target is None:
-                    return None, None
-                socket, groups = target, groups[:-1]
-            else:
-                return out, groups
-        return None, None
-
     def shader(self, socket, groups=()) -> Link | None:
         """The link a shader socket receives (None: nothing, black)."""
-        out, groups = self.source(socket, groups)
+        out, groups = source(socket, groups)
         if out is None:
             return None
         index = self.node(out.node, groups)
@@ -183,7 +145,7 @@ class GraphReader:
         """An input's copy: a Link, a constant, or None (the node's default)."""
         if socket.type == "shader":
             return self.shader(sock, groups)
-        out, got = self.source(sock, groups)
+        out, got = source(sock, groups)
         if out is None:
             if isinstance(socket.default, str):
                 return None       # an implicit texture coordinate, as Cycles fills it
@@ -230,6 +192,44 @@ class GraphReader:
                       f"{label(node)} rendered as 0.8 grey diffuse")
             return ShaderNode("BsdfDiffuse", {"Color": DEFAULT_GREY}, name=node.name)
         return ShaderNode(kind, {}, name=node.name)
+
+
+def source(socket, groups=()):
+    """What an input socket receives: (output socket, group path) of a real node, or
+    (None, value) with the constant it gets (None: nothing at all)."""
+    for _ in range(1024):
+        links = [link for link in socket.links if _carries(link)] if socket.is_linked else []
+        if not links:
+            value = getattr(socket, "default_value", None)
+            return None, value
+        out = links[0].from_socket
+        node = out.node
+        if node.bl_idname == "NodeReroute":
+            socket = node.inputs[0]
+        elif node.mute:
+            through = [lk.from_socket for lk in node.internal_links if lk.to_socket == out]
+            if not through:
+                return None, None
+            socket = through[0]
+        elif node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
+            inner = _group_output(node.node_tree)
+            if inner is None:
+                return None, None
+            target = _by_identifier(inner.inputs, out.identifier)
+            if target is None:
+                return None, None
+            socket, groups = target, groups + (node,)
+        elif node.bl_idname == "NodeGroupInput":
+            if not groups:
+                return None, None
+            outer = groups[-1]
+            target = _by_identifier(outer.inputs, out.identifier)
+            if target is None:
+                return None, None
+            socket, groups = target, groups[:-1]
+        else:
+            return out, groups
+    return None, None
 
 
 def _carries(link) -> bool:

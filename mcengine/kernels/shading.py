@@ -31,6 +31,8 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
+import numpy as np
+
 from ..jit import device, kernel
 from .closures import (
     LABEL_DIFFUSE,
@@ -244,6 +246,22 @@ def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
 
 
 @device
+def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b1, b2, obj, flags,
+                 ray_length, depths):
+    """The ``ShadingData`` of surface point ``sp`` for a ray of direction d, every field of
+    one fixed type (float64, bool, int64; numba's int() would keep an int32 an int32),
+    whatever its callers pass: the shader evaluator and every node function it calls are then
+    compiled once, not once per combination of argument types (and the compiler's folding
+    ahead of time, from Python values, uses the same compiled code)."""
+    i64 = np.int64
+    return ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
+                       -dx, -dy, -dz, bool(sp.backfacing), bool(allocate), bool(reflective),
+                       bool(refractive), bool(bump), i64(prim), float(b1), float(b2), i64(obj),
+                       i64(flags), float(ray_length), i64(depths[0]), i64(depths[1]),
+                       i64(depths[2]), i64(depths[3]), i64(depths[4]))
+
+
+@device
 def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
     direction d and length t_hit, on a path with ``flags`` and ``depths`` (bounces: all,
@@ -253,13 +271,11 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
     ``allocate`` false only emission, transparency and holdout are computed.
     """
     from_diffuse = (flags & PF_DIFFUSE) != 0
-    sd = ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
-                     -dx, -dy, -dz, sp.backfacing, allocate,
-                     cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
-                     cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
-                     (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
-                     p, b1, b2, sc.tex.tri_object[p], flags, t_hit,
-                     depths[0], depths[1], depths[2], depths[3], depths[4])
+    sd = shading_data(sp, dx, dy, dz, allocate,
+                      cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
+                      cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
+                      (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
+                      p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths)
     return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
                        sd, sc.tex)
 
@@ -271,9 +287,8 @@ def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist):
     emission varies over the surface: its shader runs there, without closures)."""
     m = sc.mat_index[tri]
     sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, tri, b1, b2, dx, dy, dz)
-    sd = ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
-                     -dx, -dy, -dz, sp.backfacing, False, True, True, False,
-                     tri, b1, b2, sc.tex.tri_object[tri], PF_SHADOW, dist, 0, 0, 0, 0, 0)
+    sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
+                      sc.tex.tri_object[tri], PF_SHADOW, dist, (0, 0, 0, 0, 0))
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                       scratch.cl_light, sd, sc.tex)
     return res.er, res.eg, res.eb

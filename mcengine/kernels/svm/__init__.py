@@ -28,6 +28,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
+import numpy as np
+
 from ...jit import device, function
 from .closure_nodes import eval_closure_node
 from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
@@ -116,7 +118,8 @@ def eval_shader(ops, start, end, regs, cl, sd, tex):
             w = regs[c] if c >= 0 else 1.0
             if w == 0.0:
                 continue
-            n, der, deg, deb, dtr, dtg, dtb, dh = eval_closure_node(a, regs, b, w, cl, n, sd)
+            n, der, deg, deb, dtr, dtg, dtb, dh = eval_closure_node(np.int64(a), regs, np.int64(b), w, cl,
+                                                                    np.int64(n), sd)
             er += der
             eg += deg
             eb += deb
@@ -125,7 +128,7 @@ def eval_shader(ops, start, end, regs, cl, sd, tex):
             tb += dtb
             holdout += dh
         elif op == OP_NODE:
-            eval_node(a, regs, b, c, sd, tex)
+            eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
         elif op == OP_COPY:
             for k in range(c):
                 regs[a + k] = regs[b + k]

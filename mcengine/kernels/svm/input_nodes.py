@@ -9,11 +9,10 @@ computed, each into its registers (``nodes.OUTPUT_OFFSETS``).
 """
 from __future__ import annotations
 
-import math
-
 from ...jit import device, function
 from ..camera import C_FWD, C_HALF_H, C_HALF_W, C_POS, C_RIGHT, C_SHIFT_X, C_SHIFT_Y, C_TYPE, C_UP, CAM_ORTHO
 from .data import ATTR_DEFAULT_UV, OBJ_INVERSE, OBJ_MATRIX, OBJ_TEXSPACE_LOC, OBJ_TEXSPACE_SIZE
+from .math_nodes import safe_normalize
 from .nodes import NODES, OFFSETS
 
 _VALUE = NODES["Value"].code
@@ -81,11 +80,22 @@ def transform_point(m, o, x, y, z):
 
 
 @device
-def _normalize(x, y, z):
-    ln = math.sqrt(x * x + y * y + z * z)
-    if ln > 0.0:
-        return x / ln, y / ln, z / ln
-    return x, y, z
+def normal_to_object(row, x, y, z):
+    """World normal -> object space, normalised: M^T n with M the object -> world matrix of
+    the object's row of ``TextureData.objects`` (Cycles' object_inverse_normal_transform)."""
+    m = OBJ_MATRIX
+    return safe_normalize(row[m] * x + row[m + 4] * y + row[m + 8] * z,
+                          row[m + 1] * x + row[m + 5] * y + row[m + 9] * z,
+                          row[m + 2] * x + row[m + 6] * y + row[m + 10] * z)
+
+
+@device
+def normal_to_world(row, x, y, z):
+    """Object normal -> world space, normalised: M^-T n (Cycles' object_normal_transform)."""
+    m = OBJ_INVERSE
+    return safe_normalize(row[m] * x + row[m + 4] * y + row[m + 8] * z,
+                          row[m + 1] * x + row[m + 5] * y + row[m + 9] * z,
+                          row[m + 2] * x + row[m + 6] * y + row[m + 10] * z)
 
 
 @device
@@ -107,11 +117,7 @@ def tex_coord(regs, b, c, sd, tex):
         gx = (ox - lx) / (2.0 * sx) + 0.5
         gy = (oy - ly) / (2.0 * sy) + 0.5
         gz = (oz - lz) / (2.0 * sz) + 0.5
-        # Normals go to object space by the transpose of the object -> world matrix.
-        m = OBJ_MATRIX
-        onx, ony, onz = _normalize(row[m] * nx + row[m + 4] * ny + row[m + 8] * nz,
-                                   row[m + 1] * nx + row[m + 5] * ny + row[m + 9] * nz,
-                                   row[m + 2] * nx + row[m + 6] * ny + row[m + 10] * nz)
+        onx, ony, onz = normal_to_object(row, nx, ny, nz)
     if regs[b + _TC_USE_OBJECT] != 0.0:
         ox, oy, oz = transform_point(regs, b + _TC_INVERSE, px, py, pz)
     u, v, _z, _w = attribute(tex, sd, ATTR_DEFAULT_UV, 2)

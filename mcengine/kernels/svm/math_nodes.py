@@ -122,9 +122,7 @@ def eval_math_node(code, regs, b, c, sd, tex):
         if int(regs[b + _CL_TYPE]) == _CLAMP_RANGE and lo > hi:
             lo, hi = hi, lo
         regs[c] = min(max(regs[b], lo), hi)
-    elif code == _SEPARATE_XYZ:
-        regs[c], regs[c + 1], regs[c + 2] = regs[b], regs[b + 1], regs[b + 2]
-    elif code == _COMBINE_XYZ:
+    elif code == _SEPARATE_XYZ or code == _COMBINE_XYZ:    # the same three registers
         regs[c], regs[c + 1], regs[c + 2] = regs[b], regs[b + 1], regs[b + 2]
     elif code == _SEPARATE_COLOR:
         x, y, z = regs[b], regs[b + 1], regs[b + 2]

@@ -144,20 +144,27 @@ def white_noise_node(regs, b, c):
     regs[o], regs[o + 1], regs[o + 2] = value, g, bl
 
 
+@device
+def scaled_point(regs, v, w_reg, scale, dim):
+    """(x, y, z, w): a texture's Vector (at regs[v:]) and W (regs[w_reg]) times Scale, as
+    many coordinates as its dimensions; a 1D point is its W, in x."""
+    x, y, z = regs[v] * scale, regs[v + 1] * scale, regs[v + 2] * scale
+    w = regs[w_reg] * scale
+    if dim == 1:
+        return w, 0.0, 0.0, 0.0
+    if dim == 2:
+        return x, y, 0.0, 0.0
+    if dim == 3:
+        return x, y, z, 0.0
+    return x, y, z, w
+
+
 @function
 def noise_node(regs, b, c):
     """Noise texture (noisetex.h): Fac and Color."""
     scale = regs[b + _NZ_SCALE]
-    v = b + _NZ_VECTOR
     dim = int(regs[b + _NZ_DIM])
-    x, y, z = regs[v] * scale, regs[v + 1] * scale, regs[v + 2] * scale
-    w = regs[b + _NZ_W] * scale
-    if dim == 1:
-        x, y, z, w = w, 0.0, 0.0, 0.0
-    elif dim == 2:
-        z = w = 0.0
-    elif dim == 3:
-        w = 0.0
+    x, y, z, w = scaled_point(regs, b + _NZ_VECTOR, b + _NZ_W, scale, dim)
     detail = min(max(regs[b + _NZ_DETAIL], 0.0), 15.0)
     roughness = max(regs[b + _NZ_ROUGHNESS], 0.0)
     fac, g, bl = noise_texture(dim, x, y, z, w, detail, roughness, regs[b + _NZ_LACUNARITY],
@@ -173,16 +180,8 @@ def noise_node(regs, b, c):
 def voronoi_node(regs, b, c):
     """Voronoi texture (voronoi.h): Distance, Color, Position, W, Radius."""
     scale = regs[b + _VO_SCALE]
-    v = b + _VO_VECTOR
     dim = int(regs[b + _VO_DIM])
-    x, y, z = regs[v] * scale, regs[v + 1] * scale, regs[v + 2] * scale
-    w = regs[b + _VO_W] * scale
-    if dim == 1:
-        x, y, z, w = w, 0.0, 0.0, 0.0
-    elif dim == 2:
-        z = w = 0.0
-    elif dim == 3:
-        w = 0.0
+    x, y, z, w = scaled_point(regs, b + _VO_VECTOR, b + _VO_W, scale, dim)
     d, r, g, bl, px, py, pz, pw, radius = voronoi_texture(
         dim, int(regs[b + _VO_FEATURE]), int(regs[b + _VO_METRIC]), x, y, z, w, scale,
         regs[b + _VO_DETAIL], regs[b + _VO_ROUGHNESS], regs[b + _VO_LACUNARITY],

@@ -80,6 +80,14 @@ def transform_point(m, o, x, y, z):
 
 
 @device
+def transform_direction(m, o, x, y, z):
+    """Row-major 3 x 4 matrix at m[o:o + 12] applied to a direction (no translation)."""
+    return (m[o] * x + m[o + 1] * y + m[o + 2] * z,
+            m[o + 4] * x + m[o + 5] * y + m[o + 6] * z,
+            m[o + 8] * x + m[o + 9] * y + m[o + 10] * z)
+
+
+@device
 def normal_to_object(row, x, y, z):
     """World normal -> object space, normalised: M^T n with M the object -> world matrix of
     the object's row of ``TextureData.objects`` (Cycles' object_inverse_normal_transform)."""

@@ -107,6 +107,9 @@ COLOR_MODES = {"RGB": 0, "HSV": 1, "HSL": 2}
 # ``vector_type``: Mapping (all four), Vector Transform (POINT, VECTOR, NORMAL).
 VECTOR_TYPES = {"POINT": 0, "TEXTURE": 1, "VECTOR": 2, "NORMAL": 3}
 
+# Vector Transform's ``convert_from`` and ``convert_to``.
+TRANSFORM_SPACES = {"WORLD": 0, "OBJECT": 1, "CAMERA": 2}
+
 # Normal Map's ``space`` (Displacement nodes use the same identifiers).
 SPACE_TANGENT = 0
 SPACE_OBJECT = 1
@@ -135,6 +138,8 @@ ENUMS = {
     "rings_direction": WAVE_RINGS_DIRECTIONS,
     "wave_profile": WAVE_PROFILES,
     "space": SPACES,
+    "convert_from": TRANSFORM_SPACES,
+    "convert_to": TRANSFORM_SPACES,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -295,6 +300,11 @@ VALUE_NODES = {
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
+    "VectorTransform": NodeSpec(502, (_v("Vector", (0.5, 0.5, 0.5)),
+                                      _p("vector_type", VECTOR_TYPES["VECTOR"]),
+                                      _p("convert_from", TRANSFORM_SPACES["WORLD"]),
+                                      _p("convert_to", TRANSFORM_SPACES["OBJECT"])),
+                                (_v("Vector"),), False),
     # -- normal family ("prop:attribute": the tangent attribute "tangent:<uv map>", see
     #    TANGENT_PREFIX; its 4 components are the MikkTSpace tangent and sign, object space)
     "NormalMap": NodeSpec(601, (_f("Strength", 1.0), _c("Color", (0.5, 0.5, 1.0)), _p("space", SPACE_TANGENT),

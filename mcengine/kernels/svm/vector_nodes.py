@@ -1,4 +1,5 @@
-"""Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h).
+"""Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h) and Vector Transform
+(kernel/svm/vector_transform.h).
 
 ``eval_vector_node`` evaluates one node of the family: inputs at regs[b:] in
 the order of ``nodes.VALUE_NODES``, outputs to regs[c:].
@@ -8,10 +9,20 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..camera import C_FWD, C_POS, C_RIGHT, C_UP
+from .data import OBJ_INVERSE, OBJ_MATRIX
+from .input_nodes import normal_to_object, normal_to_world, transform_direction, transform_point
 from .math_nodes import safe_divide, safe_normalize
-from .nodes import NODES, OFFSETS, VECTOR_TYPES
+from .nodes import NODES, OFFSETS, TRANSFORM_SPACES, VECTOR_TYPES
 
 _MAPPING = NODES["Mapping"].code
+_VECTOR_TRANSFORM = NODES["VectorTransform"].code
+_VT_TYPE = OFFSETS["VectorTransform"]["prop:vector_type"]
+_VT_FROM = OFFSETS["VectorTransform"]["prop:convert_from"]
+_VT_TO = OFFSETS["VectorTransform"]["prop:convert_to"]
+_WORLD = TRANSFORM_SPACES["WORLD"]
+_OBJECT = TRANSFORM_SPACES["OBJECT"]
+_CAMERA = TRANSFORM_SPACES["CAMERA"]
 _MP_LOCATION = OFFSETS["Mapping"]["Location"]
 _MP_ROTATION = OFFSETS["Mapping"]["Rotation"]
 _MP_SCALE = OFFSETS["Mapping"]["Scale"]
@@ -26,6 +37,8 @@ _NORMAL = VECTOR_TYPES["NORMAL"]
 def eval_vector_node(code, regs, b, c, sd, tex):
     if code == _MAPPING:
         mapping_node(regs, b, c)
+    elif code == _VECTOR_TRANSFORM:
+        vector_transform(regs, b, c, sd, tex)
 
 
 @device
@@ -66,4 +79,80 @@ def mapping_node(regs, b, c):
             x, y, z = x + tx, y + ty, z + tz
         elif kind == _NORMAL:
             x, y, z = safe_normalize(x, y, z)
+    regs[c], regs[c + 1], regs[c + 2] = x, y, z
+
+
+@device
+def _camera_axes(cam, x, y, z):
+    """(x, y, z) on the camera's axes: right, up, forward (Cycles' camera space)."""
+    return (x * cam[C_RIGHT] + y * cam[C_RIGHT + 1] + z * cam[C_RIGHT + 2],
+            x * cam[C_UP] + y * cam[C_UP + 1] + z * cam[C_UP + 2],
+            x * cam[C_FWD] + y * cam[C_FWD + 1] + z * cam[C_FWD + 2])
+
+
+@device
+def _world_to_camera(cam, kind, x, y, z):
+    if kind == _POINT:
+        return _camera_axes(cam, x - cam[C_POS], y - cam[C_POS + 1], z - cam[C_POS + 2])
+    x, y, z = _camera_axes(cam, x, y, z)
+    if kind == _NORMAL:
+        return safe_normalize(x, y, z)
+    return x, y, z
+
+
+@device
+def _camera_to_world(cam, kind, x, y, z):
+    wx = x * cam[C_RIGHT] + y * cam[C_UP] + z * cam[C_FWD]
+    wy = x * cam[C_RIGHT + 1] + y * cam[C_UP + 1] + z * cam[C_FWD + 1]
+    wz = x * cam[C_RIGHT + 2] + y * cam[C_UP + 2] + z * cam[C_FWD + 2]
+    if kind == _POINT:
+        return wx + cam[C_POS], wy + cam[C_POS + 1], wz + cam[C_POS + 2]
+    if kind == _NORMAL:
+        return safe_normalize(wx, wy, wz)
+    return wx, wy, wz
+
+
+@device
+def _object_to_world(row, kind, x, y, z):
+    if kind == _POINT:
+        return transform_point(row, OBJ_MATRIX, x, y, z)
+    if kind == _NORMAL:
+        return normal_to_world(row, x, y, z)
+    return transform_direction(row, OBJ_MATRIX, x, y, z)
+
+
+@device
+def _world_to_object(row, kind, x, y, z):
+    if kind == _POINT:
+        return transform_point(row, OBJ_INVERSE, x, y, z)
+    if kind == _NORMAL:
+        return normal_to_object(row, x, y, z)
+    return transform_direction(row, OBJ_INVERSE, x, y, z)
+
+
+@device
+def vector_transform(regs, b, c, sd, tex):
+    """Vector Transform between world, object and camera space, of a point, a direction or
+    a normal (normals through the inverse transpose and normalised).  Object space is the
+    shaded object's; without one (the world) the object step is skipped, as in Cycles."""
+    kind = int(regs[b + _VT_TYPE])
+    src, dst = int(regs[b + _VT_FROM]), int(regs[b + _VT_TO])
+    x, y, z = regs[b], regs[b + 1], regs[b + 2]
+    cam = tex.camera
+    has_object = sd.obj >= 0 and sd.prim >= 0
+    if src == _WORLD:
+        if dst == _CAMERA:
+            x, y, z = _world_to_camera(cam, kind, x, y, z)
+        elif dst == _OBJECT and has_object:
+            x, y, z = _world_to_object(tex.objects[sd.obj], kind, x, y, z)
+    elif src == _CAMERA:
+        if dst == _WORLD or dst == _OBJECT:
+            x, y, z = _camera_to_world(cam, kind, x, y, z)
+        if dst == _OBJECT and has_object:
+            x, y, z = _world_to_object(tex.objects[sd.obj], kind, x, y, z)
+    elif src == _OBJECT:
+        if (dst == _WORLD or dst == _CAMERA) and has_object:
+            x, y, z = _object_to_world(tex.objects[sd.obj], kind, x, y, z)
+        if dst == _CAMERA:
+            x, y, z = _world_to_camera(cam, kind, x, y, z)
     regs[c], regs[c + 1], regs[c + 2] = x, y, z

@@ -33,7 +33,7 @@ from mcengine.scene import Camera, Denoising, RenderPasses, SceneError
 
 from . import export
 from .export.camera import camera_from_view
-from .export.passes import result_passes
+from .export.passes import preview_denoising, result_passes
 from .export.settings import unit_scale
 from .preview import preview_integrator
 from .viewport import ViewportRender, draw_frame, parts_to_export, status_line
@@ -139,8 +139,10 @@ class MCEngine(bpy.types.RenderEngine):
         scale = max(1, int(self.get_preview_pixel_size(scene)))
         camera = camera_from_view(view.view_matrix, view.window_matrix, unit_scale(scene))
         cycles = getattr(scene, "cycles", None)
+        denoising, denoise_from = preview_denoising(scene)
         frame = render.frame(camera, max(1, region.width // scale), max(1, region.height // scale),
-                             cycles.preview_samples if cycles is not None else 0)
+                             cycles.preview_samples if cycles is not None else 0,
+                             denoising, denoise_from)
         if frame.image is not None:
             draw_frame(self, scene, frame.image, region.width, region.height)
         self.update_stats("", status_line(frame))

@@ -22,8 +22,9 @@ needs no window and is tested headless:
 
 Viewport sampling follows Cycles' viewport settings: ``preview_samples``
 samples per pixel (0: until the view changes), no time limit, no adaptive
-sampling.  The viewport renders Combined only: no render passes and no
-denoising (F12 has them).
+sampling, and the viewport's denoising (``preview_denoising*``: each image
+from the start sample on is shown denoised, with the guides it asks for).
+The viewport renders Combined only: no render passes (F12 has them).
 
 :func:`draw_frame` is the only code that needs a window: it draws the image
 with Blender's ``gpu`` module through the scene's display transform.
@@ -35,6 +36,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from mcengine.denoise import DenoiseError
 from mcengine.scene import Denoising, Film, Integrator, RenderPasses, SceneDescription
 
 from .export import PARTS
@@ -117,8 +119,9 @@ class Frame:
 class _Job:
     """One progressive render on its own thread; ``stop()`` ends it between chunks."""
 
-    def __init__(self, session_factory, desc: SceneDescription):
+    def __init__(self, session_factory, desc: SceneDescription, denoise_from: int = 1):
         self.desc = desc
+        self._denoise_from = denoise_from
         self._factory = session_factory
         self._stop = threading.Event()
         self._lock = threading.Lock()
@@ -142,9 +145,18 @@ class _Job:
     def _publish(self, session) -> None:
         if self._stop.is_set():
             return
-        image = np.asarray(session.image(bottom_up=True), np.float32)
+        samples = int(session.samples_done)
+        image = None
+        if self.desc.denoising.enabled and samples >= self._denoise_from and not self.error:
+            try:
+                image = session.denoised(bottom_up=True)
+            except DenoiseError as exc:       # shown; the noisy images go on
+                self.error = f"denoising failed ({exc}); showing the noisy image"
+        if image is None:
+            image = session.image(bottom_up=True)
+        image = np.asarray(image, np.float32)
         with self._lock:
-            self.image, self.samples = image, int(session.samples_done)
+            self.image, self.samples = image, samples
 
     def stop(self) -> None:
         self._stop.set()
@@ -203,20 +215,23 @@ class ViewportRender:
         self.stop()
 
     # -- the render --------------------------------------------------------------
-    def frame(self, camera, width: int, height: int, preview_samples: int) -> Frame:
-        """The image to draw for this view, (re)starting the render if anything changed."""
+    def frame(self, camera, width: int, height: int, preview_samples: int,
+              denoising: Denoising = Denoising(), denoise_from: int = 1) -> Frame:
+        """The image to draw for this view, (re)starting the render if anything changed;
+        ``denoising`` (the viewport's settings) applies from ``denoise_from`` samples on."""
         if self.error or self.exported is None:
             return Frame(image=None, samples=0, target=0, rendering=False, error=self.error)
         scene = self.exported.scene
         film = viewport_film(scene.film, width, height)
         integrator = viewport_integrator(scene.integrator, preview_samples)
-        key = (self._scene_version, _camera_key(camera), film, integrator.samples)
+        key = (self._scene_version, _camera_key(camera), film, integrator.samples, denoising,
+               denoise_from)
         if key != self._key or self._job is None:
             self.stop()
             self._key = key
             self._job = _Job(self._factory, replace(scene, camera=camera, film=film,
                                                     integrator=integrator, passes=RenderPasses(),
-                                                    denoising=Denoising()))
+                                                    denoising=denoising), denoise_from)
         return self._job.frame()
 
     def stop(self) -> None:

@@ -8,7 +8,9 @@ names and channels as with Cycles (``result_passes``: what
 ``update_render_passes`` registers and ``render`` adds).  Denoising reads
 ``scene.cycles`` (``use_denoising``, ``denoiser``, ``denoising_input_passes``,
 ``denoising_prefilter``, ``denoising_quality``) and the view layer's own
-switch.  What MC Engine cannot do is one warning each, naming the fallback.
+switch; the viewport's denoising reads the ``preview_denoising*`` settings
+only (as Cycles, which does not ask the view layer there).  What MC Engine
+cannot do is one warning each, naming the fallback.
 """
 from __future__ import annotations
 
@@ -26,7 +28,7 @@ from mcengine.passes import (
 )
 
 __all__ = ["enabled_passes", "export_passes", "export_denoising", "denoising_enabled",
-           "result_passes"]
+           "preview_denoising", "result_passes"]
 
 # Cycles' view layer passes MC Engine does not produce: (owner, property, what Blender calls it).
 _OTHER_PASSES = (
@@ -132,3 +134,19 @@ def export_denoising(ctx, scene, view_layer, integrator_name: str) -> Denoising:
     return Denoising(enabled=True, input_passes=input_passes,
                      prefilter=str(cycles.denoising_prefilter),
                      quality=str(getattr(cycles, "denoising_quality", "HIGH")))
+
+
+def preview_denoising(scene) -> tuple[Denoising, int]:
+    """The viewport's denoising (Render > Sampling > Viewport > Denoise) and the sample
+    from which it starts: ``scene.cycles.preview_denoising_*``.  Off when Open Image Denoise
+    is missing (the viewport then shows the noisy image; F12 warns about it)."""
+    cycles = getattr(scene, "cycles", None)
+    if cycles is None or not getattr(cycles, "use_preview_denoising", False):
+        return Denoising(enabled=False), 1
+    from mcengine.denoise import available
+    if available() is not None:
+        return Denoising(enabled=False), 1
+    return (Denoising(enabled=True, input_passes=str(cycles.preview_denoising_input_passes),
+                      prefilter=str(cycles.preview_denoising_prefilter),
+                      quality=str(cycles.preview_denoising_quality)),
+            max(1, int(cycles.preview_denoising_start_sample)))

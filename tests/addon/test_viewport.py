@@ -188,6 +188,65 @@ def test_an_export_failure_stops_the_render_and_is_shown(addon, slow_sessions):
     render.stop()
 
 
+class DenoisedSession(SlowSession):
+    """SlowSession whose denoised image is the converged gradient plus 1000 (told apart)."""
+
+    passes = 8
+    pass_seconds = 0.0
+
+    def denoised(self, bottom_up=False):
+        assert self.desc.denoising.enabled
+        out = self.target + np.float32(1000.0)
+        return out[::-1] if bottom_up else out
+
+
+def test_viewport_denoising_shows_denoised_images_from_the_start_sample(addon, slow_sessions):
+    from mcengine.denoise import Denoising
+    gate = threading.Event()
+    render = viewport.ViewportRender(lambda desc: (gate.wait(WAIT), DenoisedSession(desc))[1])
+    render.update_scene(lambda parts, previous: exported(addon, a_scene(addon)), set())
+    shown = []
+    on = Denoising(enabled=True, input_passes="RGB_ALBEDO", prefilter="FAST", quality="BALANCED")
+    render.frame(camera(), 16, 16, 8, on, denoise_from=5)
+    job = render._job
+    publish = job._publish
+    job._publish = lambda session: (publish(session), shown.append(job.frame()))
+    gate.set()                                          # the session starts after the spy is in
+    assert render.wait(WAIT)
+    assert [f.samples for f in shown] == list(range(1, 9))
+    target = slow_sessions[0].target[::-1]
+    for f in shown:
+        denoised = np.allclose(f.image, target + 1000.0)
+        assert denoised == (f.samples >= 5), f.samples
+    assert slow_sessions[0].desc.denoising == on
+    # Denoising off: the same view and samples restart the render, which shows noisy images.
+    render.frame(camera(), 16, 16, 8)
+    assert wait_for(lambda: len(slow_sessions) == 2) and render.wait(WAIT)
+    final = render.frame(camera(), 16, 16, 8)
+    assert not slow_sessions[1].desc.denoising.enabled
+    np.testing.assert_allclose(final.image, target, rtol=1e-6)
+
+
+def test_viewport_denoising_reads_the_viewport_settings(scene, addon):
+    from mcengine.denoise import available
+    scene.cycles.use_denoising = True                   # F12's switch: not the viewport's
+    scene.cycles.use_preview_denoising = False
+    assert not addon.export.passes.preview_denoising(scene)[0].enabled
+    scene.cycles.use_preview_denoising = True
+    scene.cycles.preview_denoising_input_passes = "RGB_ALBEDO_NORMAL"
+    scene.cycles.preview_denoising_prefilter = "NONE"
+    scene.cycles.preview_denoising_quality = "FAST"
+    scene.cycles.preview_denoising_start_sample = 4
+    bpy.context.view_layer.cycles.use_denoising = False  # the view layer's: F12 only, as Cycles
+    denoising, start = addon.export.passes.preview_denoising(scene)
+    if available() is not None:
+        assert not denoising.enabled
+        return
+    assert denoising.enabled and start == 4
+    assert (denoising.input_passes, denoising.prefilter, denoising.quality) == \
+        ("RGB_ALBEDO_NORMAL", "NONE", "FAST")
+
+
 def test_preview_samples_zero_renders_until_stopped(addon):
     it = viewport.viewport_integrator(a_scene(addon).integrator, 0)
     assert it.samples == viewport.UNLIMITED_SAMPLES and it.time_limit == 0

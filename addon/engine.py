@@ -188,7 +188,7 @@ class MCEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, warning)
         # The first render after installing compiles the numba kernels (cached afterwards).
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "
-                              f"render compiles its kernels, about a minute)")
+                              f"render compiles its kernels, a few minutes)")
         render = depsgraph.scene.render
         # Blender's Performance > Threads setting; AUTO leaves the choice to the core.
         threads = render.threads if render.threads_mode == "FIXED" else None

@@ -42,7 +42,7 @@ def render_icon(idblock, timeout: float = 300.0) -> np.ndarray:
     Blender renders icons on a job thread, and without a window nothing tells
     when the job ends, so the icon's pixels are polled until they are written
     and stop changing.  Raises TimeoutError after ``timeout`` seconds (a cold
-    numba cache first compiles the kernels, about a minute and a half).
+    numba cache first compiles the kernels, a few minutes).
     """
     import bpy
 

@@ -259,7 +259,7 @@ def status_line(frame: Frame) -> str:
     if frame.error:
         return f"MC Engine: {frame.error}"
     if frame.image is None:
-        return "Preparing renderer (the first render compiles its kernels, about a minute)" \
+        return "Preparing renderer (the first render compiles its kernels, a few minutes)" \
             if frame.rendering else ""
     if frame.target >= UNLIMITED_SAMPLES:
         return f"Sample {frame.samples}"

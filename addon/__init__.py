@@ -19,15 +19,17 @@ __all__ = ["register", "unregister"]
 
 
 def register() -> None:
-    from . import engine, operators, properties, ui
+    from . import engine, operators, properties, ui, warmup
     properties.register()
     engine.register()
     operators.register()
     ui.register()
+    warmup.start()
 
 
 def unregister() -> None:
-    from . import engine, operators, properties, ui
+    from . import engine, operators, properties, ui, warmup
+    warmup.stop()
     ui.unregister()
     operators.unregister()
     engine.unregister()

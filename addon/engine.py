@@ -31,7 +31,7 @@ import numpy as np
 
 from mcengine.scene import Camera, Denoising, RenderPasses, SceneError
 
-from . import export
+from . import export, warmup
 from .export.camera import camera_from_view
 from .export.passes import preview_denoising, result_passes
 from .export.settings import unit_scale
@@ -153,7 +153,9 @@ class MCEngine(bpy.types.RenderEngine):
         render = getattr(self, "_mcengine_viewport", None)
         if render is None:
             # Looked up at each render, so that tests and the command line can replace it.
-            render = ViewportRender(lambda desc: session_factory(desc))
+            # On the render's thread: it waits for a background kernel compile to end.
+            render = ViewportRender(lambda desc: (warmup.wait(lambda: False),
+                                                  session_factory(desc))[1])
             self._mcengine_viewport = render
         return render
 
@@ -186,6 +188,10 @@ class MCEngine(bpy.types.RenderEngine):
             exported.scene.denoising = Denoising()
         for warning in () if self.is_preview else exported.scene.warnings:
             self.report({"WARNING"}, warning)
+        # Kernels being compiled in the background since the add-on was enabled: wait for
+        # them rather than compile them twice.
+        if not warmup.wait(self.test_break, lambda line: self.update_stats("", line)):
+            return None, None
         # The first render after installing compiles the numba kernels (cached afterwards).
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "
                               f"render compiles its kernels, a few minutes)")

@@ -61,6 +61,23 @@ def _cache_dir() -> str | None:
 
 
 _CACHE_DIR = _cache_dir()
+_READY = "kernels-compiled"     # marker file: mcengine.warmup compiled every kernel here
+
+
+def cache_folder() -> Path:
+    """The folder numba's cache of these sources is in."""
+    return Path(_CACHE_DIR or config.CACHE_DIR)
+
+
+def cache_is_ready() -> bool:
+    """True once ``mcengine.warmup`` has compiled the kernels of these sources."""
+    return (cache_folder() / _READY).exists()
+
+
+def mark_cache_ready() -> None:
+    folder = cache_folder()
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / _READY).touch()
 
 
 def _cached(decorator):

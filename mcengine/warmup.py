@@ -1,0 +1,62 @@
+"""Compile the renderer's kernels ahead of the first render, into numba's disk cache.
+
+A render loads its kernels from the cache in a fraction of a second once
+they are compiled; compiling them takes minutes (``jit``).  The add-on runs
+this module in a background process when it is enabled and the cache of the
+installed sources is not ready, so that the first F12 finds them compiled::
+
+    python -m mcengine.warmup        # prints the seconds taken; exit 0 when ready
+
+It renders one sample of one pixel of a tiny scene with the default
+integrator (every shader node and closure is compiled with the shader
+evaluator, whatever the scene uses), then marks the cache ready
+(``jit.cache_is_ready``).  The other integrators compile at their first use.
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from . import integrators, jit
+from .scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription
+
+__all__ = ["warm_up_scene", "compile_kernels", "main"]
+
+
+def warm_up_scene() -> SceneDescription:
+    """One quad under a point lamp, seen by a one-pixel camera: one sample."""
+    quad = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
+                    np.float64)
+    camera = np.eye(4)
+    camera[2, 3] = 3.0
+    lamp = np.eye(4)
+    lamp[:3, 3] = (0.5, 0.5, 2.0)
+    return SceneDescription(
+        geometry=Geometry.from_triangles(quad), materials=[Material()],
+        lights=[Light(type="POINT", matrix_world=lamp, radius=0.1)],
+        camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
+        integrator=Integrator(name=integrators.DEFAULT, samples=1))
+
+
+def compile_kernels() -> float:
+    """Compile (or load) the default integrator's kernels; seconds taken."""
+    from .session import RenderSession
+    start = time.perf_counter()
+    RenderSession(warm_up_scene(), threads=1).run()
+    jit.mark_cache_ready()
+    return time.perf_counter() - start
+
+
+def main() -> int:
+    if jit.cache_is_ready():
+        print("mcengine: kernels already compiled")
+        return 0
+    seconds = compile_kernels()
+    print(f"mcengine: kernels compiled in {seconds:.1f} s into {jit.cache_folder()}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

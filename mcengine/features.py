@@ -68,6 +68,9 @@ class EffectsPlan:
     emissive_triangles: int = 0
     lobes: tuple = ()              # kinds of surface, in LOBE_ORDER
     textures: int = 0              # materials whose shaders evaluate nodes at every hit
+    images: int = 0                # images the shaders read
+    world_shader: bool = False     # the world varies (its shader runs for escaped rays)
+    world_sampled: bool = False    # the world is a light for next-event estimation (its map)
     # The effects (see the module docstring); each is a kernel flag.
     nee: bool = False
     lamps_hit: bool = False
@@ -101,11 +104,14 @@ class EffectsPlan:
             n = self.emissive_triangles
             lights.append(f"{n} emissive triangle{'s' if n > 1 else ''}")
         if self.world:
-            lights.append("world")
+            lights.append("world (sampled)" if self.world_sampled
+                          else "world shader" if self.world_shader else "world")
         on = [EFFECTS[n][0] + (" (forced)" if n in self.forced else "") for n in self.effects_on()]
         off = [EFFECTS[n][0] for n in EFFECTS if not getattr(self, n)]
         textures = (f"{self.textures} textured material{'s' if self.textures > 1 else ''}"
                     if self.textures else "no textures")
+        if self.images:
+            textures += f", {self.images} image{'s' if self.images > 1 else ''}"
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
                 f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures} | "
                 f"simulated: {', '.join(on) if on else 'nothing'} | "
@@ -144,16 +150,22 @@ CASTERS = {"rough glossy", "sharp glossy", "coat", "rough glass", "sharp glass",
 RECEIVERS = {"diffuse", "rough diffuse", "sheen", "translucent"}
 
 
-def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=None) -> EffectsPlan:
+def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=None,
+           world=None, images: int = 0) -> EffectsPlan:
     """The plan for ``scene`` given its emissive triangle count, lamp powers, the MF_*
-    flags of its materials and their shader programs (``(ops, ranges)``)."""
+    flags of its materials and their shader programs (``(ops, ranges)``); ``world`` is
+    (gives light, varies, sampled by next-event estimation) (None: its constant colour
+    decides) and ``images`` the number of images the shaders read."""
+    if world is None:
+        world = (bool(np.max(np.asarray(scene.world.color, float)) > 0.0), False, False)
+    world_lit, world_shader, world_sampled = world
     lamps = [li for li, pw in zip(scene.lights, lamp_power) if pw > 0.0]
     used = sorted(set(np.unique(scene.geometry.material_index).tolist()))
     kinds = set()
     for i in used:
         kinds |= surface_kinds(scene.materials[i])
     lamps_hit = lamps_hit_by_rays(lamps)
-    nee = bool(lamps) or emissive_triangles > 0
+    nee = bool(lamps) or emissive_triangles > 0 or world_sampled
     textures = 0
     if programs is not None:
         ops, ranges = programs
@@ -164,10 +176,13 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
-        world=bool(np.max(np.asarray(scene.world.color, float)) > 0.0),
+        world=bool(world_lit),
+        world_shader=bool(world_lit and world_shader),
+        world_sampled=bool(world_sampled),
+        images=int(images),
         lamps_hit=lamps_hit,
         nee=nee,
-        mis=nee and (lamps_hit or emissive_triangles > 0),
+        mis=nee and (lamps_hit or emissive_triangles > 0 or world_sampled),
         caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
     )
 

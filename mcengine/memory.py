@@ -10,7 +10,8 @@ grows with the scene and the image:
 * the host's own buffers for the image (Blender's render result), which the
   caller states per pixel;
 * the wavefront buffers of every worker thread (bounded by the batch size);
-* the scene: triangle tables and Embree's BVH (``BYTES_PER_TRIANGLE``), lamps.
+* the scene: triangle tables and Embree's BVH (``BYTES_PER_TRIANGLE``), lamps, and
+  the texels of its images (``images.ImageTable``).
 
 What the machine can give is the smallest of the kernel's available memory
 (``MemAvailable``), the cgroup's limit minus its usage (containers), and the
@@ -41,26 +42,29 @@ class MemoryEstimate:
     host_image: int
     buffers: int
     scene: int
+    textures: int = 0
 
     @property
     def total(self) -> int:
-        return self.film + self.host_image + self.buffers + self.scene + SLACK_BYTES
+        return self.film + self.host_image + self.buffers + self.scene + self.textures + SLACK_BYTES
 
     def describe(self) -> str:
         return (f"about {self.total / GIB:.2f} GiB (film {self.film / GIB:.2f}, image "
                 f"{self.host_image / GIB:.2f}, path buffers {self.buffers / GIB:.2f}, scene "
-                f"{self.scene / GIB:.2f})")
+                f"{self.scene / GIB:.2f}, images {self.textures / GIB:.2f})")
 
 
 def estimate(pixels: int, triangles: int, buffer_bytes: int, host_bytes_per_pixel: int = 0,
-             pass_bytes_per_pixel: int = 0) -> MemoryEstimate:
+             pass_bytes_per_pixel: int = 0, texture_bytes: int = 0) -> MemoryEstimate:
     """Memory a render of ``pixels`` pixels and ``triangles`` triangles needs, in bytes
-    (``pass_bytes_per_pixel``: the film's render-pass sums)."""
+    (``pass_bytes_per_pixel``: the film's render-pass sums; ``texture_bytes``: its images'
+    texels)."""
     return MemoryEstimate(
         film=pixels * (FILM_BYTES_PER_PIXEL + pass_bytes_per_pixel),
         host_image=pixels * (IMAGE_BYTES_PER_PIXEL + host_bytes_per_pixel),
         buffers=buffer_bytes,
-        scene=triangles * BYTES_PER_TRIANGLE)
+        scene=triangles * BYTES_PER_TRIANGLE,
+        textures=texture_bytes)
 
 
 def available() -> int | None:

@@ -16,8 +16,11 @@ from typing import NamedTuple
 import numpy as np
 
 from . import cryptomatte, integrators, samplers
+from .background import importance_map, map_size
 from .features import EffectsPlan, lamps_intersectable
 from .features import detect as detect_plan
+from .images import ImageTable
+from .kernels.background import bake_background
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
@@ -45,11 +48,14 @@ from .kernels.state import (
     CFG_SIZE,
     CFG_SOBOL_MASK,
     CFG_WORLD_CAMERA,
+    CFG_WORLD_SHADER,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     FCFG_SIZE,
+    FCFG_WORLD_IMPORTANCE,
+    FCFG_WORLD_PMF,
     MF_EMISSION_VARIES,
     MF_EMISSIVE,
     SceneData,
@@ -64,6 +70,7 @@ from .kernels.svm import (
     OBJ_STRIDE,
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
+    OP_NODE,
     TextureData,
 )
 from .passes import kernel_data
@@ -111,7 +118,11 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
 
     layout, attr = pack_attributes(g)
-    shaders = ShaderTable(scene.materials, layout)
+    images = ImageTable(scene.images)
+    shaders = ShaderTable(scene.materials + [scene.world.material()], layout, images.slots)
+    world = len(scene.materials)            # the world's program follows the materials'
+    start, end = shaders.ranges[world]
+    world_varies = bool(np.any(shaders.ops[start:end, 0] == OP_NODE))
     mat_index = np.ascontiguousarray(g.material_index, np.int32)
     film = scene.film
     camera = pack_camera(scene.camera, film)
@@ -124,10 +135,27 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
         emit_cdf=np.zeros(1), emit_group=np.zeros(5), tri_light=np.full(len(tris), -1, np.int32),
         tri_area=tri_area, tri_normal=tri_normal,
-        world=np.asarray(scene.world.color, np.float64).reshape(3), camera=camera,
+        world=shaders.emission[world].copy(), camera=camera,
         filter_table=filter_table(film.filter_type, film.filter_width),
-        tex=TextureData(attr=attr, normals=normals, tri_object=np.ascontiguousarray(g.object_index, np.int32),
-                        objects=pack_objects(g), camera=camera))
+        tex=TextureData(attr=attr, normals=normals,
+                        tri_object=np.ascontiguousarray(g.object_index, np.int32),
+                        objects=pack_objects(g), camera=camera, images=images.info,
+                        pix8=images.pix8, pixf=images.pixf),
+        bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)))
+
+    # The world as a light: its importance map, when its radiance varies.
+    world_importance = world_power = 0.0
+    size = map_size(scene.world, scene.images) if world_varies else None
+    if size is not None:
+        bake_cfg = np.zeros(CFG_SIZE, np.int64)
+        bake_cfg[CFG_WORLD_SHADER] = 1
+        baked = np.zeros((size[1], size[0], 3))
+        bake_background(sc, bake_cfg, alloc_scratch(sc), baked)
+        marginal, conditional, mean = importance_map(baked)
+        if mean > 0.0:
+            sc = sc._replace(bg_marginal=marginal, bg_conditional=conditional)
+            world_importance = math.pi * mean                     # irradiance, as a sun's
+            world_power = world_importance * math.pi * scene_radius ** 2
 
     # Lights: lamps, and the triangles of emissive materials.
     if len(tris):
@@ -146,7 +174,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
 
     lamps, lamp_power = pack_lights(scene.lights, scene_radius)
-    cdf, lamp_pmf, emit_pmf = light_distribution(lamp_power, emit_power)
+    cdf, lamp_pmf, emit_pmf, world_pmf = light_distribution(lamp_power, emit_power, world_power)
     emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
     if emit_cdf[-1] > 0:
         emit_cdf /= emit_cdf[-1]
@@ -166,7 +194,9 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
             not_sun = lamps[:, L_TYPE] != LT_SUN
             lamps[not_sun, L_FLAGS] = (lamps[not_sun, L_FLAGS].astype(np.int64) & ~LF_VIS_CAMERA)
     plan = detect_plan(scene, len(emit_tri), lamp_power, shaders.flags,
-                       (shaders.ops, shaders.ranges))
+                       (shaders.ops, shaders.ranges),
+                       (world_varies or bool(shaders.emission[world].max() > 0.0), world_varies,
+                        world_power > 0.0), len(images.slots))
     if force_effects:
         plan = plan.force(force_effects)
 
@@ -187,6 +217,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     cfg[CFG_WORLD_CAMERA] = 1 if scene.world.visible_camera else 0
     cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W] = x0, y0, x1 - x0
     cfg[CFG_FULL_W] = film.width
+    cfg[CFG_WORLD_SHADER] = 1 if world_varies else 0
     cfg[CFG_CAUSTICS_REFLECTIVE] = 1 if it.caustics_reflective else 0
     cfg[CFG_CAUSTICS_REFRACTIVE] = 1 if it.caustics_refractive else 0
     plan.flags(cfg)
@@ -199,9 +230,12 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     fcfg[FCFG_CLAMP_INDIRECT] = 3.0 * it.clamp_indirect if it.clamp_indirect > 0 else math.inf
     emit_share = float(emit_pmf.sum())
     fcfg[FCFG_EMIT_SCALE] = 1.0 / emit_share if emit_share > 0 else 0.0
+    fcfg[FCFG_WORLD_PMF] = world_pmf
+    fcfg[FCFG_WORLD_IMPORTANCE] = world_importance
     # Per-point light picking pays for itself when there is a choice to make and
     # the scan over lamps stays short.
-    n_choices = int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
+    n_choices = (int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
+                 + (1 if world_power > 0.0 else 0))
     cfg[CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
     return PackedScene(sc, cfg, fcfg, plan)
 

@@ -32,8 +32,8 @@ from .denoise import Denoising
 from .passes import RenderPasses
 
 __all__ = [
-    "SceneError", "ObjectPassInfo", "Geometry", "Link", "ShaderNode", "Material", "Light", "Camera",
-    "World", "Film", "Integrator", "SceneDescription", "RenderPasses", "Denoising",
+    "SceneError", "ObjectPassInfo", "Geometry", "Link", "ShaderNode", "Material", "Image", "Light",
+    "Camera", "World", "Film", "Integrator", "SceneDescription", "RenderPasses", "Denoising",
 ]
 
 LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
@@ -45,6 +45,8 @@ MAX_BLADES = 100000             # aperture blades; beyond, a polygon is a disk t
 PI_FLOAT32 = float(np.float32(np.pi))
 AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
+IMAGE_COLORSPACES = ("sRGB", "linear", "data")
+IMAGE_ALPHA_MODES = ("STRAIGHT", "PREMUL", "CHANNEL_PACKED", "NONE")
 
 
 class SceneError(ValueError):
@@ -301,6 +303,31 @@ class Material:
 
 
 @dataclass
+class Image:
+    """A texture image, read by the Image and Environment Texture nodes (``props["image"]``
+    is its name in ``SceneDescription.images``).
+
+    ``pixels`` is (H, W, C) uint8 (8-bit images) or float32 (float images), C = 1 to 4
+    channels (grey, grey and alpha, RGB, RGBA), bottom row first as in Blender.
+    ``colorspace`` says how texels become scene-linear colours: "sRGB" (decoded after
+    interpolation, as Cycles does for images in an sRGB-equivalent space), "linear" (as
+    stored) or "data" (Non-Color: as stored, and its alpha is never multiplied into the
+    colour).  ``alpha`` is Blender's alpha mode: "STRAIGHT" (the colour is multiplied by
+    alpha when the render loads it), "PREMUL" (already multiplied, as Blender's float
+    buffers are), "CHANNEL_PACKED" (alpha independent of the colour), "NONE" (alpha read as
+    1).
+    """
+
+    pixels: np.ndarray = field(default_factory=lambda: np.zeros((1, 1, 4), np.uint8))
+    colorspace: str = "sRGB"
+    alpha: str = "STRAIGHT"
+
+    @property
+    def nbytes(self) -> int:
+        return int(np.asarray(self.pixels).nbytes)
+
+
+@dataclass
 class Light:
     """A Blender lamp, in Cycles' units (see module docstring).
 
@@ -362,12 +389,44 @@ class Camera:
     aperture_ratio: float = 1.0      # anamorphic squeeze: lens x is divided by it
 
 
+WORLD_SAMPLING = ("NONE", "AUTOMATIC", "MANUAL")
+
+
 @dataclass
 class World:
-    """Constant background: radiance = colour x strength."""
+    """The background: light arriving from infinitely far along rays that escape.
+
+    ``nodes`` and ``surface`` are the world's shader graph, as a material's
+    (Background and Emission nodes emit their Color x Strength; Mix and Add
+    Shader combine them; value nodes such as an Environment Texture feed them,
+    the point being the ray's direction).  A world without ``nodes`` is the
+    constant radiance ``color``.  ``visible_camera`` is the camera ray
+    visibility; ``sampling`` and ``map_resolution`` are Cycles' world settings
+    Sampling Method (None, Automatic, Manual) and Map Resolution: how next-event
+    estimation samples the background.
+    """
 
     color: tuple = (0.0509, 0.0509, 0.0509)
     visible_camera: bool = True
+    nodes: list = field(default_factory=list)
+    surface: Link | None = None
+    sampling: str = "AUTOMATIC"
+    map_resolution: int = 1024
+
+    @property
+    def name(self) -> str:
+        return "world"
+
+    def graph(self) -> tuple[list, Link | None]:
+        """(nodes, surface link): the graph, or a Background node of ``color``."""
+        if self.nodes:
+            return self.nodes, self.surface
+        return [ShaderNode("Background", {"Color": tuple(self.color), "Strength": 1.0})], Link(0, "Background")
+
+    def material(self) -> "Material":
+        """The graph as a material, for the shader compiler."""
+        nodes, surface = self.graph()
+        return Material(name="world", nodes=nodes, surface=surface)
 
 
 @dataclass
@@ -442,6 +501,7 @@ class SceneDescription:
     passes: RenderPasses = field(default_factory=RenderPasses)
     denoising: Denoising = field(default_factory=Denoising)
     warnings: list = field(default_factory=list)
+    images: dict = field(default_factory=dict)       # name -> Image
 
     # -- validation --------------------------------------------------------
     def validate(self) -> "SceneDescription":
@@ -508,6 +568,12 @@ class SceneDescription:
             _check_number(where, "spread", li.spread, lo=0.0, hi=PI_FLOAT32)
             _check_number(where, "max_bounces", li.max_bounces, lo=0)
         _check_vector("world", "color", self.world.color, 3)
+        _check_graph("world", self.world)
+        if self.world.sampling not in WORLD_SAMPLING:
+            raise SceneError(f"world: unknown sampling {self.world.sampling!r} ({', '.join(WORLD_SAMPLING)})")
+        _check_number("world", "map_resolution", self.world.map_resolution, lo=4, hi=MAX_RESOLUTION)
+        for name, im in self.images.items():
+            _check_image(name, im)
         f = self.film
         for attr in ("width", "height"):
             _check_number("film", attr, getattr(f, attr), lo=1, hi=MAX_RESOLUTION)
@@ -575,11 +641,14 @@ class SceneDescription:
         matrix, texspace, info = g.object_arrays()
         meta["attributes"] = list(g.attributes)
         attributes = {f"attribute{k}": a for k, a in enumerate(g.attributes.values())}
+        meta["images"] = [{"name": name, "colorspace": im.colorspace, "alpha": im.alpha}
+                          for name, im in self.images.items()]
+        images = {f"image{k}": im.pixels for k, im in enumerate(self.images.values())}
         np.savez_compressed(
             path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
             object_matrix=matrix, object_texspace=texspace, object_info=info, **attributes,
-            meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
+            **images, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
 
     @staticmethod
     def load(path) -> "SceneDescription":
@@ -628,6 +697,8 @@ def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
     for name in present:
         if name.startswith("attribute"):
             expected[name] = ("f", None)
+        elif name.startswith("image"):
+            expected[name] = ("fu", "image")
     for name, (kinds, trailing) in expected.items():
         with archive.open(f"{name}.npy") as f:
             version = np.lib.format.read_magic(f)
@@ -636,6 +707,8 @@ def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
             shape, _fortran, dtype = read_header(f)
         if trailing is None and len(shape) == 3 and shape[1] == 3:   # an attribute: (T, 3, C)
             trailing = tuple(shape[1:])
+        if trailing == "image" and len(shape) == 3 and dtype in (np.uint8, np.float32):
+            trailing = tuple(shape[1:])                               # an image: (H, W, C)
         if dtype.kind not in kinds or dtype.hasobject or tuple(shape[1:]) != trailing \
                 or len(shape) != 1 + len(trailing):
             raise SceneError(f"{path}: array {name!r} has dtype {dtype} and shape {shape}")
@@ -672,11 +745,14 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
     film = dict(meta["film"])
     if film.get("region") is not None:
         film["region"] = tuple(film["region"])
+    images = {str(d["name"]): Image(pixels=z[f"image{k}"], colorspace=str(d["colorspace"]),
+                                    alpha=str(d["alpha"]))
+              for k, d in enumerate(meta.get("images", []))}
     return SceneDescription(
-        geometry=geom,
+        geometry=geom, images=images,
         materials=[_material_from_saved(d) for d in meta["materials"]],
         lights=lights, camera=Camera(**cam),
-        world=World(**{k: (tuple(v) if isinstance(v, list) else v) for k, v in meta["world"].items()}),
+        world=_world_from_saved(meta["world"]),
         film=Film(**film), integrator=Integrator(**_integrator_meta(meta["integrator"])),
         passes=RenderPasses(**{k: (tuple(v) if isinstance(v, list) else v)
                                for k, v in meta.get("passes", {}).items()}),
@@ -731,6 +807,21 @@ def _check_matrix(where: str, value, axes: bool = False) -> None:
         raise SceneError(f"{where}: matrix_world has a zero-length axis (scale 0)")
 
 
+def _check_image(name, im) -> None:
+    where = f"image {name!r}"
+    if not isinstance(name, str) or not isinstance(im, Image):
+        raise SceneError(f"{where}: images must map names to Image")
+    p = np.asarray(im.pixels)
+    if p.ndim != 3 or not 1 <= p.shape[2] <= 4 or p.shape[0] < 1 or p.shape[1] < 1 \
+            or p.dtype not in (np.uint8, np.float32):
+        raise SceneError(f"{where}: pixels must be (H, W, 1..4) uint8 or float32, got "
+                         f"{p.dtype} {p.shape}")
+    if im.colorspace not in IMAGE_COLORSPACES:
+        raise SceneError(f"{where}: unknown colour space {im.colorspace!r} ({', '.join(IMAGE_COLORSPACES)})")
+    if im.alpha not in IMAGE_ALPHA_MODES:
+        raise SceneError(f"{where}: unknown alpha mode {im.alpha!r} ({', '.join(IMAGE_ALPHA_MODES)})")
+
+
 def _check_graph(where: str, material: Material) -> None:
     """Links point at existing nodes and every constant input is finite."""
     nodes = material.nodes
@@ -749,16 +840,27 @@ def _check_graph(where: str, material: Material) -> None:
                              f"which does not exist")
 
 
-def _material_from_saved(d: dict) -> Material:
-    """A material from its saved form (links are dicts, colours lists)."""
-    def value(v):
-        if isinstance(v, dict):
-            return Link(int(v["node"]), str(v["socket"]))
-        return tuple(v) if isinstance(v, list) else v
+def _saved_value(v):
+    """A saved input or setting: links are dicts, colours lists."""
+    if isinstance(v, dict):
+        return Link(int(v["node"]), str(v["socket"]))
+    return tuple(v) if isinstance(v, list) else v
+
+
+def _graph_from_saved(d: dict) -> dict:
+    """A saved material's or world's fields, its graph as nodes and links again."""
     d = dict(d)
-    d["nodes"] = [ShaderNode(type=n["type"], inputs={k: value(v) for k, v in n["inputs"].items()},
+    d["nodes"] = [ShaderNode(type=n["type"], inputs={k: _saved_value(v) for k, v in n["inputs"].items()},
                              props=dict(n.get("props", {})), name=n.get("name", ""))
                   for n in d.get("nodes", [])]
     if d.get("surface") is not None:
-        d["surface"] = value(d["surface"])
-    return Material(**{k: (value(v) if k not in ("nodes", "surface") else v) for k, v in d.items()})
+        d["surface"] = _saved_value(d["surface"])
+    return {k: (_saved_value(v) if k not in ("nodes", "surface") else v) for k, v in d.items()}
+
+
+def _material_from_saved(d: dict) -> Material:
+    return Material(**_graph_from_saved(d))
+
+
+def _world_from_saved(d: dict) -> World:
+    return World(**_graph_from_saved(d))

@@ -77,6 +77,7 @@ class RenderStats:
     samples_done: int = 0
     samples_target: int = 0
     eta_seconds: float = float("nan")
+    texture_bytes: int = 0          # texels of the images the shaders read
     extra: dict = field(default_factory=dict)
 
     @property
@@ -128,6 +129,8 @@ class RenderStats:
                 f"export {t['export']:.2f} s, BVH {t['bvh']:.2f} s, kernels {t['kernels']:.2f} s, "
                 f"tracing {t['tracing']:.2f} s, shading {t['shading']:.2f} s (thread-seconds), "
                 f"wall {t['render']:.2f} s")
+        if self.texture_bytes:
+            line += f" | images {self.texture_bytes / (1 << 20):.1f} MiB"
         if self.nonfinite:
             line += f" | {self.nonfinite:,} non-finite samples dropped"
         return line
@@ -242,6 +245,7 @@ class RenderSession:
         self.stats = RenderStats(samples_target=it.samples)
         # The effects plan (``features``): what the scene calls for, as kernel flags.
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
+        self.stats.texture_bytes = int(self.sc.tex.pix8.nbytes + self.sc.tex.pixf.nbytes)
         self.integrator = integrator_info(it.name)
         self._classic_setup()
         guides = ((P_DENOISING_ALBEDO,) if scene.denoising.uses_albedo else ()) + \
@@ -393,7 +397,8 @@ class RenderSession:
         need = memory.estimate(pixels, self.scene.geometry.num_triangles,
                                self.threads * _Buffers.bytes_for(self.batch_size, self._classic,
                                                                  self._path_passes),
-                               host_bytes_per_pixel, 8 * self.pass_layout.stride)
+                               host_bytes_per_pixel, 8 * self.pass_layout.stride,
+                               self.stats.texture_bytes)
         free = memory.available()
         if free is not None and need.total > free:
             raise SceneError(f"not enough memory: this render needs {need.describe()}, "

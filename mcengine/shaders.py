@@ -27,7 +27,8 @@ Programs are plain int32/float64 arrays, so a saved scene renders without
 Blender and the kernels see one format for every material.  Attributes are
 found by name in an :class:`AttributeLayout` (the scene's per-corner
 attributes: UV maps, colour attributes); a missing one reads as zeros, as in
-Cycles.
+Cycles.  Images are found by name in the render's image slots
+(``images.ImageTable.slots``); a missing one reads magenta, as in Cycles.
 """
 from __future__ import annotations
 
@@ -42,6 +43,7 @@ from .kernels.svm import (
     CONV_COLOR_TO_FLOAT,
     CONV_FLOAT_TO_VECTOR,
     CONV_VECTOR_TO_FLOAT,
+    IMG_STRIDE,
     MAX_REGS,
     OBJ_STRIDE,
     OP_CLOSURE,
@@ -60,6 +62,7 @@ from .kernels.svm.nodes import (
     COLOR,
     ENUMS,
     FLOAT,
+    IMAGE_NODES,
     IMPLICIT,
     MATRIX,
     SHADER,
@@ -138,17 +141,22 @@ class Program:
 
 
 def compile_material(material: Material, attributes: AttributeLayout | None = None,
-                     base: int = 0) -> Program:
+                     base: int = 0, images: dict | None = None) -> Program:
     """Compile ``material`` from register ``base`` on (SceneError names an unsupported node,
-    a bad link or a cycle)."""
-    return _Compiler(material, attributes or AttributeLayout(), base).compile()
+    a bad link or a cycle); ``images`` maps image names to their slots."""
+    return _Compiler(material, attributes or AttributeLayout(), base, images or {}).compile()
 
 
 class _Compiler:
-    def __init__(self, material: Material, attributes: AttributeLayout, base: int):
+    def __init__(self, material: Material, attributes: AttributeLayout, base: int, images: dict):
         self.material = material
         self.nodes, self.surface = material.graph()
         self.attributes = attributes
+        self.images = images
+        # Output sockets something is linked to, by node (Cycles computes an image's
+        # unassociated colour only when its Alpha output is used).
+        self.linked = {(v.node, v.socket) for n in self.nodes for v in n.inputs.values()
+                       if isinstance(v, Link)}
         self.program = Program(base=base)
         self.outputs: dict[int, dict] = {}       # value node -> its outputs (name -> Value)
         self.implicit: dict[str, Value] = {}     # texture coordinates inserted for unlinked inputs
@@ -223,6 +231,8 @@ class _Compiler:
     def prop(self, node, socket) -> tuple:
         """A property as register values (``nodes`` module docstring)."""
         name = socket.name[5:]
+        if name == "image":
+            return (-1.0,)          # an image's name: its slot is found by image_inputs
         value = node.props.get(name, socket.default)
         if socket.type == TABLE:
             flat = [float(v) for v in np.asarray(value, float).ravel()]
@@ -256,17 +266,21 @@ class _Compiler:
             raise self.error(f"{node.type} has no output '{link.socket}'")
         return outputs[link.socket]
 
-    def coordinate(self, name: str) -> Value:
-        """The Texture Coordinate output ``name`` (one node per material)."""
-        if "TexCoord" not in self.implicit:
-            self.implicit["TexCoord"] = self.evaluate(ShaderNode("TexCoord"), VALUE_NODES["TexCoord"])
-        return self.implicit["TexCoord"][name]
+    def coordinate(self, implicit: tuple) -> Value:
+        """Output ``implicit`` = (node type, output) of the coordinate node of that type that
+        the compiler inserts for unlinked inputs (one per material)."""
+        kind, name = implicit
+        if kind not in self.implicit:
+            self.implicit[kind] = self.evaluate(ShaderNode(kind), VALUE_NODES[kind])
+        return self.implicit[kind][name]
 
     def evaluate(self, node, spec) -> dict:
         """Compile value node ``node`` (or fold it); its outputs by name."""
         values = [self.input(node, socket) for socket in spec.inputs]
         if node.type in _ATTRIBUTE_READERS:
             values = self.attribute_inputs(node, spec, values)
+        elif node.type in IMAGE_NODES:
+            values = self.image_inputs(node, spec, values)
         if spec.pure and all(v.constant for v in values):
             return self.fold(spec, values)
         base = self.block(spec.inputs, values)
@@ -286,6 +300,17 @@ class _Compiler:
         values[names.index("prop:attribute")] = Value(FLOAT, (float(offset),))
         if "prop:attribute_size" in names:
             values[names.index("prop:attribute_size")] = Value(FLOAT, (float(size),))
+        return values
+
+    def image_inputs(self, node, spec, values) -> list:
+        """The image an image node reads, found by name (-1: none, magenta), and whether its
+        Alpha output is used."""
+        names = [s.name for s in spec.inputs]
+        slot = self.images.get(str(node.props.get("image", "")), -1)
+        values[names.index("prop:image")] = Value(FLOAT, (float(slot),))
+        index = next(k for k, n in enumerate(self.nodes) if n is node)
+        linked = 1.0 if (index, "Alpha") in self.linked else 0.0
+        values[names.index("prop:alpha_linked")] = Value(FLOAT, (linked,))
         return values
 
     def fold(self, spec, values) -> dict:
@@ -348,7 +373,9 @@ _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0,
                           False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0)
 _NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
                            tri_object=np.zeros(0, np.int32),
-                           objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS))
+                           objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
+                           images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
+                           pixf=np.zeros(0, np.float32))
 
 
 class ShaderTable:
@@ -365,12 +392,13 @@ class ShaderTable:
     transparent to shadow rays, bump-map correction.
     """
 
-    def __init__(self, materials, attributes: AttributeLayout | None = None):
+    def __init__(self, materials, attributes: AttributeLayout | None = None,
+                 images: dict | None = None):
         ops, ranges, init = [], [], {}
         programs = []
         base = 0
         for m in materials:
-            program = compile_material(m, attributes, base)
+            program = compile_material(m, attributes, base, images)
             base += program.registers
             ranges.append([len(ops), len(ops) + len(program.ops)])
             ops.extend(program.ops)

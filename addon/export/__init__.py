@@ -52,6 +52,8 @@ class ExportContext:
     ignored : list of str
         Short names of the scene features the renderer ignored ("specular",
         "textures", ...), without duplicates.
+    images : dict
+        The images the shader graphs read, by name (``export.images``).
     """
 
     def __init__(self, scene):
@@ -61,6 +63,7 @@ class ExportContext:
         self.unit_scale = unit_scale(scene)
         self.warnings: list[str] = []
         self.ignored: list[str] = []
+        self.images: dict = {}
 
     def warn(self, message: str, *ignored: str) -> None:
         """Record a warning once, plus the names of the features it ignores."""
@@ -133,6 +136,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
                                                  desc.integrator.name)
     else:
         desc.passes, desc.denoising = old.passes, old.denoising
+    desc.images = _images_used(desc, {**(old.images if old is not None else {}), **ctx.images})
     desc.warnings = list(ctx.warnings)
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
@@ -175,6 +179,14 @@ def _materials_in_order(ctx, depsgraph) -> list:
             for slot in ob.material_slots:
                 table.index(slot.material)
     return table.materials
+
+
+def _images_used(desc: SceneDescription, images: dict) -> dict:
+    """The images some node of the scene's shader graphs reads (a re-export keeps the
+    previous export's images of the parts it reuses)."""
+    graphs = [m.nodes for m in desc.materials] + [getattr(desc.world, "nodes", [])]
+    names = {str(n.props.get("image", "")) for nodes in graphs for n in nodes}
+    return {name: im for name, im in images.items() if name in names}
 
 
 def _instance_name(inst) -> str:

@@ -61,10 +61,18 @@ def _tex_coord_props(node, ctx) -> dict:
     return {"use_object": 1.0, "object_inverse": np.linalg.inv(m)[:3, :].ravel().tolist()}
 
 
+def _image_props(node, ctx) -> dict:
+    """Image and Environment Texture: the image, by its name in the export's images."""
+    from .images import export_image
+    return {"image": export_image(ctx, node.image)}
+
+
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
 # ramps, curves), which the generic property copy cannot.
 SPECIAL_PROPS = {
     "TexCoord": _tex_coord_props,
+    "TexImage": _image_props,
+    "TexEnvironment": _image_props,
 }
 
 

@@ -1,11 +1,15 @@
-"""The scene world -> :class:`mcengine.scene.World` (a constant background).
+"""The scene world -> :class:`mcengine.scene.World`.
 
-Radiance = Background (or Emission) node 'Color' x 'Strength', read from the
-node linked to the Surface socket of the world's active Cycles output.  A
-linked Color or Strength (sky or environment textures, ...) is replaced by
-the socket's unlinked value; any other shader falls back to ``world.color``;
-both are warned.  Nothing linked: black, as in Cycles.  A world without a
-node tree uses ``world.color``; no world at all is black.
+The world's shader graph is what the Surface socket of its active Cycles output
+receives, copied by :class:`shader_graph.GraphReader` as a material's is
+(reroutes, muted nodes, groups, every node the core evaluates: Background and
+Emission, Mix and Add Shader, Environment Texture, Light Path, ...).  A graph
+whose radiance does not vary is rendered as a constant colour at no cost per
+ray.  Sky Texture and other unsupported nodes are warned, their consumer keeping
+its unlinked value.  Nothing linked: black, as in Cycles.  A world without a node
+tree uses ``world.color``; no world at all is black.  Cycles' world settings
+Sampling Method and Map Resolution are copied; the world's diffuse, glossy and
+transmission ray visibility switches are warned (the world lights everything).
 """
 from __future__ import annotations
 
@@ -14,11 +18,12 @@ import math
 from mcengine.scene import World
 
 from .materials import clamp_color, fmt, linked_node
+from .shader_graph import GraphReader
 
 __all__ = ["export_world"]
 
 BLACK = (0.0, 0.0, 0.0)
-_CONSTANT_SHADERS = ("ShaderNodeBackground", "ShaderNodeEmission")
+_CONSTANT_SHADERS = ("Background", "Emission")
 
 
 def export_world(ctx, world) -> World:
@@ -31,37 +36,43 @@ def export_world(ctx, world) -> World:
     if hidden:
         ctx.warn(f"world '{world.name}': ray visibility ({', '.join(hidden)} off) not supported "
                  f"yet; the world lights everything", "world ray visibility")
-    color = _world_color(ctx, world)
+    settings = getattr(world, "cycles", None)
+    common = dict(visible_camera=bool(visibility.camera),
+                  sampling=str(getattr(settings, "sampling_method", "AUTOMATIC")),
+                  map_resolution=int(getattr(settings, "sample_map_resolution", 1024)))
+    tree = world.node_tree
+    if tree is None:
+        return World(color=_finite(ctx, world, clamp_color(world.color[:3])), **common)
+    out = tree.get_output_node("CYCLES")
+    if out is None:
+        return World(color=BLACK, **common)
+    if linked_node(out.inputs["Volume"]) is not None:
+        ctx.warn(f"world '{world.name}': volume shader not supported yet; ignored", "world volume")
+    graph = GraphReader(ctx)
+    surface = graph.shader(out.inputs["Surface"])
+    if graph.items:
+        ctx.warn(f"world '{world.name}': {', '.join(graph.items)} not supported yet; "
+                 f"{'; '.join(graph.fallbacks) or 'ignored'}", *graph.features)
+    if surface is None:
+        return World(color=BLACK, **common)
+    for node in graph.nodes:
+        for name, value in node.inputs.items():
+            if isinstance(value, tuple) and not all(math.isfinite(v) for v in value) or \
+                    isinstance(value, float) and not math.isfinite(value):
+                ctx.warn(f"world '{world.name}': {node.name} '{name}' {fmt(value)} is not finite; "
+                         f"the world is rendered black", "non-finite world")
+                return World(color=BLACK, **common)
+    if len(graph.nodes) == 1 and graph.nodes[0].type in _CONSTANT_SHADERS:
+        # One Background (or Emission) of constant colour: the constant world.
+        inputs = graph.nodes[0].inputs
+        color, strength = inputs.get("Color", (0.8, 0.8, 0.8)), inputs.get("Strength", 1.0)
+        return World(color=clamp_color([c * strength for c in color]), **common)
+    return World(color=BLACK, nodes=graph.nodes, surface=surface, **common)
+
+
+def _finite(ctx, world, color) -> tuple:
     if not all(math.isfinite(c) for c in color):
         ctx.warn(f"world '{world.name}': background {fmt(color)} is not finite; rendered black",
                  "non-finite world")
-        color = BLACK
-    return World(color=color, visible_camera=bool(visibility.camera))
-
-
-def _world_color(ctx, world) -> tuple:
-    tree = world.node_tree
-    if tree is None:
-        return clamp_color(world.color[:3])
-    out = tree.get_output_node("CYCLES")
-    if out is None:
         return BLACK
-    if linked_node(out.inputs["Volume"]) is not None:
-        ctx.warn(f"world '{world.name}': volume shader not supported yet; ignored", "world volume")
-    shader = linked_node(out.inputs["Surface"])
-    if shader is None:
-        return BLACK
-    if shader.bl_idname not in _CONSTANT_SHADERS:
-        color = clamp_color(world.color[:3])
-        ctx.warn(f"world '{world.name}': {shader.label or shader.name} shader not supported yet; "
-                 f"using the world's viewport colour {fmt(color)}", "world shader")
-        return color
-    color, strength = shader.inputs["Color"], shader.inputs["Strength"]
-    linked = [f"{(linked_node(s).label or linked_node(s).name)} into '{s.name}'"
-              for s in (color, strength) if linked_node(s) is not None]
-    value = clamp_color([c * strength.default_value for c in color.default_value[:3]])
-    if linked:
-        ctx.warn(f"world '{world.name}': {', '.join(linked)} not supported yet; using the "
-                 f"unlinked values, background {fmt(value)}", "world textures")
-    return value
-
+    return color

@@ -178,7 +178,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
                     continue
         if p < 0:
-            acc[root, 3] += light_from_background(sc, cfg, fcfg, stats, acc, root, st.beta, i,
+            acc[root, 3] += light_from_background(sc, cfg, fcfg, scratch, stats, acc, root, st.beta, i,
                                                   dx, dy, dz, flags, mis_pdf, PMF_EVERY,
                                                   mpx, mpy, mpz, 0.0, direct)
             continue
@@ -220,7 +220,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                     pmf = sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
                 lu, lv, _, _ = sample_4d(SAMPLER_INDEPENDENT, lkey, SET_LIGHT, _NO_MASK)
-                n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
+                n_shadow = direct_light(sc, cfg, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
                                         scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
                                         nee_mis, float(branching),
                                         cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])

@@ -69,16 +69,20 @@ def _no_light():
     return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0, 0.0, 0.0, 0.0, -1, 0.0, 0.0)
 
 
-def light_distribution(lamp_power, tri_power):
-    """CDF over lamps then emissive triangles; (cdf, lamp pmf, triangle pmf)."""
-    w = np.concatenate([lamp_power, tri_power]).astype(np.float64)
+def light_distribution(lamp_power, tri_power, world_power=0.0):
+    """CDF over lamps, then emissive triangles, then the world (when it is sampled: its
+    power > 0); (cdf, lamp pmf, triangle pmf, world pmf)."""
+    w = np.concatenate([lamp_power, tri_power, [world_power] if world_power > 0 else []])
+    w = w.astype(np.float64)
     total = w.sum()
     if total <= 0.0:
-        return np.zeros(len(w) + 1), np.zeros(len(lamp_power)), np.zeros(len(tri_power))
+        return np.zeros(len(w) + 1), np.zeros(len(lamp_power)), np.zeros(len(tri_power)), 0.0
     pmf = w / total
     cdf = np.concatenate([[0.0], np.cumsum(pmf)])
     cdf[-1] = 1.0
-    return cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):]
+    n = len(lamp_power) + len(tri_power)
+    return (cdf, pmf[:len(lamp_power)], pmf[len(lamp_power):n],
+            float(pmf[n]) if world_power > 0 else 0.0)
 
 
 @device
@@ -143,9 +147,10 @@ def nee_exclude(lamp_flags):
 
 
 @device
-def local_light_total(lamps, group, has_group, px, py, pz):
-    """Sum of every light's importance at p (lamps, and the emissive triangles as one)."""
-    total = 0.0
+def local_light_total(lamps, group, has_group, world, px, py, pz):
+    """Sum of every light's importance at p (lamps, the emissive triangles as one, and the
+    world's constant importance ``world``, 0 when it is not sampled)."""
+    total = world
     for li in range(lamps.shape[0]):
         total += lamp_importance(lamps, li, px, py, pz)
     if has_group:
@@ -164,18 +169,21 @@ def lamp_pick_pmf(lamps, li, pmf_mode, px, py, pz, total):
 
 
 @device
-def pick_light_local(lamps, group, has_group, px, py, pz, u):
+def pick_light_local(lamps, group, has_group, world, px, py, pz, u):
     """Pick a light at p in proportion to its importance there.
 
-    Returns ``(choice, pmf)``: a lamp index, or ``n_lamps`` for the emissive
-    triangles as a group; ``pmf`` 0 if nothing can light p.
+    Returns ``(choice, pmf)``: a lamp index, ``n_lamps`` for the emissive
+    triangles as a group, or ``n_lamps + 1`` for the world (of importance
+    ``world``); ``pmf`` 0 if nothing can light p.
     """
     n_lamps = lamps.shape[0]
-    total = local_light_total(lamps, group, has_group, px, py, pz)
+    total = local_light_total(lamps, group, has_group, world, px, py, pz)
     if total <= 0.0:
         return 0, 0.0
     target = u * total
-    acc = 0.0
+    if target < world:
+        return n_lamps + 1, world / total
+    acc = world
     last = -1
     last_w = 0.0
     for li in range(n_lamps):
@@ -187,6 +195,8 @@ def pick_light_local(lamps, group, has_group, px, py, pz, u):
                 return li, w / total
     if has_group:
         return n_lamps, group_importance(group, px, py, pz) / total
+    if last < 0:
+        return n_lamps + 1, world / total
     return last, last_w / total      # rounding at the end of the scan
 
 

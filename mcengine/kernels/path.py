@@ -92,6 +92,7 @@ from .state import (
     CFG_SOBOL_MASK,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
+    FCFG_WORLD_IMPORTANCE,
     MF_EMISSIVE,
     PF_DENOISE,
     PF_MIS_SKIP,
@@ -129,6 +130,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     local = cfg[CFG_LOCAL_LIGHTS] != 0
     pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
     has_group = sc.emit_tri.shape[0] > 0
+    world_light = n_lamps + sc.emit_tri.shape[0]      # NEE's index of the world
+    world_importance = fcfg[FCFG_WORLD_IMPORTANCE]
     max_transparent = cfg[CFG_MAX_TRANSPARENT]
     sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
     for i in range(n):
@@ -151,7 +154,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
         mis_total = 0.0
         if local and mis and not (flags & PF_MIS_SKIP):
-            mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, mpx, mpy, mpz)
+            mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, world_importance,
+                                          mpx, mpy, mpz)
 
         # -- light arriving along the ray ------------------------------------------------------
         if lamps_hit:
@@ -169,8 +173,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         if p < 0:
             if light_passes:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
-            st.transparency[i] += light_from_world(sc, cfg, fcfg, stats, st.radiance, i, st.beta,
-                                                   i, flags, direct)
+            st.transparency[i] += light_from_world(sc, cfg, fcfg, scratch, stats, st.radiance, i,
+                                                   st.beta, i, dx, dy, dz, flags, mis_pdf,
+                                                   pmf_mode, mis_total, direct)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_BACKGROUND)
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
@@ -239,9 +244,11 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         if nee:
             lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
             if local:
-                idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, sp.hx, sp.hy, sp.hz,
-                                            u_pick)
-                if idx == n_lamps:
+                idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, world_importance,
+                                            sp.hx, sp.hy, sp.hz, u_pick)
+                if idx == n_lamps + 1:
+                    idx = world_light
+                elif idx == n_lamps:
                     j = pick_light(sc.emit_cdf, u_group)
                     idx = n_lamps + j
                     pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
@@ -251,7 +258,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             if split:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
                 queued = n_shadow
-            n_shadow = direct_light(sc, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
+            n_shadow = direct_light(sc, cfg, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
                                     scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
                                     True, 1.0, max_transparent - st.transparent[i])
             if split:

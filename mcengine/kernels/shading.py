@@ -34,6 +34,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device, kernel
+from .background import background_pdf, sample_background, world_radiance
 from .closures import (
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
@@ -45,7 +46,9 @@ from .closures import (
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
     PMF_EVERY,
+    PMF_GLOBAL,
     PMF_LOCAL,
+    LightSample,
     emission_weight,
     group_importance,
     lamps_on_segment,
@@ -64,6 +67,8 @@ from .state import (
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
+    FCFG_WORLD_IMPORTANCE,
+    FCFG_WORLD_PMF,
     MF_BUMP_CORRECTION,
     MF_EMISSION_VARIES,
     PF_CAMERA,
@@ -196,27 +201,39 @@ def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy
 
 
 @device
-def light_from_background(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
-                          pmf_mode, mpx, mpy, mpz, mis_total, direct):
+def light_from_background(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz, flags,
+                          mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct):
     """Add the world's and the suns' light to an escaped ray.
 
     Returns the film transparency it leaves: on a transparent film a camera
     ray (also through transparent surfaces) sees no background, and the
     pixel's alpha drops by its average throughput.
     """
-    transparency = light_from_world(sc, cfg, fcfg, stats, out, row, beta, i, flags, direct)
+    transparency = light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz,
+                                    flags, mis_pdf, pmf_mode, mis_total, direct)
     light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
                     pmf_mode, mpx, mpy, mpz, mis_total, direct)
     return transparency
 
 
 @device
-def light_from_world(sc, cfg, fcfg, stats, out, row, beta, i, flags, direct):
+def light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
+                     pmf_mode, mis_total, direct):
     """The world's part of ``light_from_background`` (returns the film transparency)."""
     transparent_film = cfg[CFG_FILM_TRANSPARENT] != 0 and (flags & PF_TRANSPARENT_BG) != 0
     if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
-        add_light(out, row, beta[i, 0] * sc.world[0], beta[i, 1] * sc.world[1],
-                  beta[i, 2] * sc.world[2], direct, fcfg, stats)
+        wr, wg, wb = world_radiance(sc, cfg, scratch, dx, dy, dz, flags)
+        # MIS against next-event estimation's sample of the world (when it makes one).
+        pick = 0.0
+        if pmf_mode == PMF_LOCAL:
+            pick = fcfg[FCFG_WORLD_IMPORTANCE] / mis_total if mis_total > 0.0 else 0.0
+        elif pmf_mode == PMF_GLOBAL:
+            pick = fcfg[FCFG_WORLD_PMF]
+        if pick > 0.0 and not (flags & PF_MIS_SKIP):
+            w = power_heuristic(mis_pdf, pick * background_pdf(sc.bg_marginal, sc.bg_conditional,
+                                                               dx, dy, dz))
+            wr, wg, wb = wr * w, wg * w, wb * w
+        add_light(out, row, beta[i, 0] * wr, beta[i, 1] * wg, beta[i, 2] * wb, direct, fcfg, stats)
     if transparent_film:
         return (beta[i, 0] + beta[i, 1] + beta[i, 2]) / 3.0
     return 0.0
@@ -327,10 +344,26 @@ def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, cos_o, flag
 
 # -- 5. next-event estimation -----------------------------------------------------------------
 @device
-def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl, sp, dx, dy, dz, idx,
-                 pmf, bounce, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
+def world_light_sample(sc, cfg, scratch, pmf, u1, u2):
+    """A direction towards the world drawn from its importance map (picked with
+    probability ``pmf``), as a :class:`LightSample` (radiance from the world's shader,
+    evaluated as for a light: no ray-type flags)."""
+    wix, wiy, wiz, pdf = sample_background(sc.bg_marginal, sc.bg_conditional, u1, u2)
+    pdf_l = pmf * pdf
+    if pdf_l <= 0.0:
+        return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0,
+                           0.0, 0.0, 0.0, -1, 0.0, 0.0)
+    r, g, b = world_radiance(sc, cfg, scratch, wix, wiy, wiz, 0)
+    return LightSample(wix, wiy, wiz, math.inf, r / pdf_l, g / pdf_l, b / pdf_l, pdf_l, True, True,
+                       0, 0.0, 0.0, 0.0, -1, 0.0, 0.0)
+
+
+@device
+def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl, sp, dx, dy, dz,
+                 idx, pmf, bounce, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
     """Light from light ``idx`` (picked with probability ``pmf``) scattered at ``sp`` by
-    the ``ncl`` closures in ``scratch.cl`` towards the viewer (-d).
+    the ``ncl`` closures in ``scratch.cl`` towards the viewer (-d).  Lights are the lamps,
+    then the emissive triangles, then the world (``world_light_sample``).
 
     The light is added to ``out[row]`` at once if the light casts no shadow,
     else queued behind a shadow ray owned by ``row``; returns the queue length.
@@ -341,8 +374,12 @@ def direct_light(sc, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl,
     """
     if pmf <= 0.0:
         return n_shadow
-    ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
-                      sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2)
+    if idx == sc.lamps.shape[0] + sc.emit_tri.shape[0]:
+        ls = world_light_sample(sc, cfg, scratch, pmf, u1, u2)
+    else:
+        ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
+                          sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce,
+                          u1, u2)
     scratch.light[0], scratch.light[1], scratch.light[2] = ls.wix, ls.wiy, ls.wiz
     scratch.light[3] = ls.exclude
     lr, lg, lb = ls.lr, ls.lg, ls.lb

@@ -65,7 +65,8 @@ SceneData = namedtuple("SceneData", [
     "svm_ops",       # (P, 4) int32  every material's shader program (kernels.svm)
     "svm_regs",      # (R,) f64      their registers with the constants in place (each worker
                      #               shades with its own copy, Scratch.regs)
-    "mat_prog",      # (M, 2) int32  [start, end) of material m's program in svm_ops
+    "mat_prog",      # (M + 1, 2) int32  [start, end) of material m's program in svm_ops;
+                     #               row M is the world's (its shader, for rays that escape)
     "mat_emission",  # (M, 3) f64    emitted radiance of material m as a light (no layering)
     "mat_flags",     # (M,) int32    MF_* bits
     "lamps",         # (NL, LIGHT_STRIDE) f64
@@ -77,10 +78,12 @@ SceneData = namedtuple("SceneData", [
     "tri_light",     # (T,) int32   index into emit_tri, or -1
     "tri_area",      # (T,) f64
     "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
-    "world",         # (3,) f64     background radiance
+    "world",         # (3,) f64     background radiance (when constant: CFG_WORLD_SHADER 0)
     "camera",        # (CAMERA_PARAMS,) f64
     "filter_table",  # (FILTER_TABLE_SIZE,) f64
     "tex",           # svm.TextureData: attributes, objects, images for the shader nodes
+    "bg_marginal",   # (H + 1,) f64   the world's importance map: CDF over its rows
+    "bg_conditional",  # (H, W + 1) f64  CDF over the columns of each row (kernels.background)
 ])
 
 # Material flags (mat_flags).
@@ -131,13 +134,17 @@ CFG_MIS = 20              # emission found by rays gets MIS weights (some light 
 CFG_CAUSTICS = 21         # caustic paths: Filter Glossy and the caustics switches apply
 CFG_SAMPLER = 22          # sampling.SAMPLER_*: which numbers paths draw
 CFG_SOBOL_MASK = 23       # mask of the Sobol sampler's shuffled sample index (sobol.index_mask)
-CFG_SIZE = 24
+CFG_WORLD_SHADER = 24     # the background varies (textures, ray types): run the world's shader
+CFG_SIZE = 25
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1
 FCFG_EMIT_SCALE = 2       # 1 / (share of the emissive triangles in the scene-wide pmf)
 FCFG_FILTER_GLOSSY = 3    # Cycles' blur_glossy; 0: off
-FCFG_SIZE = 4
+FCFG_WORLD_PMF = 4        # probability that NEE picks the world when lights are picked by
+                          # power (0: the world is not sampled)
+FCFG_WORLD_IMPORTANCE = 5  # the world's importance when lights are picked per point (0: idem)
+FCFG_SIZE = 6
 
 # Statistics counters (stats array, per worker).
 ST_CAMERA_RAYS = 0

@@ -166,5 +166,5 @@ def test_world_texture_uses_the_unlinked_value(scene, fake_session):
     desc = export_scene(fake_session)
     assert desc.world.color == pytest.approx((0.1, 0.2, 0.3))
     assert [w for w in desc.warnings if w.startswith("world")] == [
-        "world 'Sky': Sky Texture into 'Color' not supported yet; using the unlinked values, "
-        "background (0.1, 0.2, 0.3)"]
+        "world 'Sky': Sky Texture into Background 'Color' not supported yet; "
+        "unlinked value of Background 'Color' used"]

@@ -120,33 +120,39 @@ def compile_kernels_apart() -> None:
 _compiled = False
 
 
-def render_cases(cases: dict) -> dict:
-    """Render the cases with Cycles and MC Engine: name -> (cycles, mcengine) images."""
+def render_both(scene) -> dict:
+    """Render ``scene`` with Cycles and MC Engine: engine name -> HxWx3 image (top row first)."""
     import bpy
 
     from mcengine_blender.batch.render import ensure_registered
     compile_kernels_apart()
     ensure_registered()
+    images = {}
+    for engine in ("CYCLES", "MCENGINE"):
+        scene.render.engine = engine
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "out.exr"
+            scene.render.image_settings.file_format = "OPEN_EXR"
+            scene.render.image_settings.color_depth = "32"
+            scene.render.filepath = str(path)
+            bpy.ops.render.render(write_still=True)
+            img = bpy.data.images.load(str(path))
+            w, h = img.size
+            px = np.array(img.pixels[:], np.float32).reshape(h, w, 4)[::-1, :, :3]
+            bpy.data.images.remove(img)
+        images[engine] = px
+    return images
+
+
+def render_cases(cases: dict) -> dict:
+    """Render the cases with Cycles and MC Engine: name -> (cycles, mcengine) images."""
     out = {}
     names = list(cases)
     per_scene = GRID * GRID
     for start in range(0, len(names), per_scene):
         chunk = {name: cases[name] for name in names[start:start + per_scene]}
         scene, rows, cols = _scene(chunk)
-        images = {}
-        for engine in ("CYCLES", "MCENGINE"):
-            scene.render.engine = engine
-            with tempfile.TemporaryDirectory() as tmp:
-                path = Path(tmp) / "out.exr"
-                scene.render.image_settings.file_format = "OPEN_EXR"
-                scene.render.image_settings.color_depth = "32"
-                scene.render.filepath = str(path)
-                bpy.ops.render.render(write_still=True)
-                img = bpy.data.images.load(str(path))
-                w, h = img.size
-                px = np.array(img.pixels[:], np.float32).reshape(h, w, 4)[::-1, :, :3]
-                bpy.data.images.remove(img)
-            images[engine] = px
+        images = render_both(scene)
         if __import__('os').environ.get('NODE_DEBUG'):
             np.save(f'/tmp/nodes_{start}.npy', np.stack([images['CYCLES'], images['MCENGINE']]))
         for k, name in enumerate(chunk):

@@ -35,6 +35,7 @@ from .closure_nodes import eval_closure_node
 from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ATTR_DEFAULT_UV,
+    IMG_STRIDE,
     OBJ_COLOR,
     OBJ_INVERSE,
     OBJ_MATRIX,
@@ -46,9 +47,10 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ShadingData,
     TextureData,
 )
+from .image_nodes import eval_image_node
 from .input_nodes import eval_input_node
 from .math_nodes import eval_math_node
-from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_NORMAL, FAMILY_TEXTURE, FAMILY_VECTOR
+from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_NORMAL, FAMILY_TEXTURE, FAMILY_VECTOR, IMAGE_CODES
 from .normal_nodes import eval_normal_node
 from .texture_nodes import eval_texture_node
 from .vector_nodes import eval_vector_node
@@ -83,7 +85,10 @@ def eval_node(code, regs, b, c, sd, tex):
     elif family == FAMILY_MATH:
         eval_math_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_TEXTURE:
-        eval_texture_node(code, regs, b, c, sd, tex)
+        if code >= IMAGE_CODES:
+            eval_image_node(code, regs, b, c, sd, tex)
+        else:
+            eval_texture_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_VECTOR:
         eval_vector_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_NORMAL:

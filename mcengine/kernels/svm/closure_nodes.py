@@ -74,6 +74,7 @@ from .nodes import (
     GL_IOR,
     GL_NORMAL,
     GL_ROUGHNESS,
+    K_BACKGROUND,
     K_DIFFUSE,
     K_EMISSION,
     K_GLASS,
@@ -306,7 +307,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
     if kind == K_PRINCIPLED:
         return principled(regs, b, w, cl, n, sd)
     cr, cg, cb = regs[b + COLOR_IN] * w, regs[b + COLOR_IN + 1] * w, regs[b + COLOR_IN + 2] * w
-    if kind == K_EMISSION:
+    if kind == K_EMISSION or kind == K_BACKGROUND:
         s = regs[b + E_STRENGTH]
         return n, cr * s, cg * s, cb * s, 0.0, 0.0, 0.0, 0.0
     if kind == K_HOLDOUT:

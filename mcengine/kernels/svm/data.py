@@ -34,6 +34,9 @@ TextureData = namedtuple("TextureData", [
     "tri_object",              # (T,) int32     object of each triangle
     "objects",                 # (O, OBJ_STRIDE) f64  per-object data (OBJ_* columns)
     "camera",                  # (CAMERA_PARAMS,) f64  the camera (Camera and Window coordinates)
+    "images",                  # (I, IMG_STRIDE) int64  the render's images (IMG_* columns)
+    "pix8",                    # (N,) uint8    texels of the 8-bit images, row after row
+    "pixf",                    # (N,) float32  texels of the float images
 ])
 
 # Per-object data (TextureData.objects columns).
@@ -48,3 +51,16 @@ OBJ_STRIDE = 36
 
 # The default UV map's offset in TextureData.attr (always present, 2 components).
 ATTR_DEFAULT_UV = 0
+
+# Images (TextureData.images columns): where an image's texels start in its pool (pix8 or
+# pixf), its size, channels (1 or 4), pool and flags.  Texels are stored bottom row first,
+# alpha already associated (premultiplied) as Cycles loads them (``mcengine.images``).
+IMG_OFFSET = 0
+IMG_WIDTH = 1
+IMG_HEIGHT = 2
+IMG_CHANNELS = 3
+IMG_FLOAT = 4                 # 1: texels in pixf, else in pix8 (divided by 255)
+IMG_FLAGS = 5
+IMG_STRIDE = 6
+IMGF_SRGB = 1                 # stored sRGB-encoded: decoded after interpolation
+IMGF_UNASSOCIATE = 2          # a linked Alpha output divides the colour by alpha

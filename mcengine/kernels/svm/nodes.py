@@ -84,6 +84,27 @@ WAVE_PROFILES = {"SIN": 0, "SAW": 1, "TRI": 2}
 
 # Enum properties: property name -> {Blender's identifier: code}.  A node's enum inputs
 # ("prop:<name>") are encoded with the table of that name.
+# Image Texture and Environment Texture settings (Blender's identifiers; "Smart" renders as
+# Cubic in Cycles).  The two nodes share the property name "projection".
+INTERP_LINEAR = 0
+INTERP_CLOSEST = 1
+INTERP_CUBIC = 2
+INTERPOLATIONS = {"Linear": INTERP_LINEAR, "Closest": INTERP_CLOSEST, "Cubic": INTERP_CUBIC,
+                  "Smart": INTERP_CUBIC}
+EXT_REPEAT = 0
+EXT_EXTEND = 1
+EXT_CLIP = 2
+EXT_MIRROR = 3
+EXTENSIONS = {"REPEAT": EXT_REPEAT, "EXTEND": EXT_EXTEND, "CLIP": EXT_CLIP, "MIRROR": EXT_MIRROR}
+PROJ_FLAT = 0
+PROJ_BOX = 1
+PROJ_SPHERE = 2
+PROJ_TUBE = 3
+PROJ_EQUIRECTANGULAR = 4
+PROJ_MIRROR_BALL = 5
+PROJECTIONS = {"FLAT": PROJ_FLAT, "BOX": PROJ_BOX, "SPHERE": PROJ_SPHERE, "TUBE": PROJ_TUBE,
+               "EQUIRECTANGULAR": PROJ_EQUIRECTANGULAR, "MIRROR_BALL": PROJ_MIRROR_BALL}
+
 # Operations of the Math and Vector Math nodes (one ``operation`` property, one table: the
 # identifiers both nodes share have one code).  Cycles' NodeMathType / NodeVectorMathType.
 OPERATIONS = {name: k for k, name in enumerate((
@@ -140,6 +161,9 @@ ENUMS = {
     "space": SPACES,
     "convert_from": TRANSFORM_SPACES,
     "convert_to": TRANSFORM_SPACES,
+    "interpolation": INTERPOLATIONS,
+    "extension": EXTENSIONS,
+    "projection": PROJECTIONS,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -149,9 +173,12 @@ IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)   # a 3 
 
 # Defaults of texture coordinate inputs that Cycles fills from the shading point when
 # nothing is linked (the compiler links a Texture Coordinate output there instead).
+# IMPLICIT: default -> (node type, output) the compiler links there.
 GENERATED = "generated"
 UV = "uv"
-IMPLICIT = {GENERATED: "Generated", UV: "UV"}
+POSITION = "position"          # the point (world shaders: the ray direction)
+IMPLICIT = {GENERATED: ("TexCoord", "Generated"), UV: ("TexCoord", "UV"),
+            POSITION: ("NewGeometry", "Position")}
 
 
 def _f(name, default):
@@ -202,6 +229,9 @@ CLOSURES = {
     "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
                          (Socket("Emission", SHADER, None),), False),
     "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
+    # The world's light (an Emission by another name: Color x Strength).
+    "Background": NodeSpec(11, (_c("Color", GREY), _f("Strength", 1.0)),
+                           (Socket("Background", SHADER, None),), False),
 }
 
 # Nodes that only route closures.
@@ -217,7 +247,9 @@ SHADER_ROUTING = {
 FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, constants
 FAMILY_MATH = 2        # svm/math_nodes.py: Math, Vector Math, Map Range, converters
 FAMILY_COLOR = 3       # svm/color_nodes.py: Mix, ColorRamp, curves, colour adjustments
-FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural and image textures
+FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural textures (401-449);
+                       # svm/image_nodes.py: image textures (450-469)
+IMAGE_CODES = 450      # first code of the image nodes
 FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Transform
 FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump
 
@@ -297,6 +329,18 @@ VALUE_NODES = {
     "TexMagic": NodeSpec(408, (_v("Vector", GENERATED), _f("Scale", 5.0), _f("Distortion", 1.0),
                                _p("turbulence_depth", 2)),
                          (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    # Images (svm/image_nodes.py, codes 450-469).  "prop:image" is the image's slot in the
+    # render's image table (the compiler finds the node's image by name; -1: missing, magenta);
+    # "prop:alpha_linked" is 1 when the Alpha output is used (Cycles then divides the colour
+    # by alpha).
+    "TexImage": NodeSpec(450, (_v("Vector", UV), _p("image", -1), _p("interpolation", INTERP_LINEAR),
+                               _p("extension", EXT_REPEAT), _p("projection", PROJ_FLAT),
+                               _p("projection_blend", 0.0), _p("alpha_linked", 0)),
+                         (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), False),
+    "TexEnvironment": NodeSpec(451, (_v("Vector", POSITION), _p("image", -1),
+                                     _p("interpolation", INTERP_LINEAR),
+                                     _p("projection", PROJ_EQUIRECTANGULAR), _p("alpha_linked", 0)),
+                               (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), False),
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
@@ -310,6 +354,7 @@ VALUE_NODES = {
     "NormalMap": NodeSpec(601, (_f("Strength", 1.0), _c("Color", (0.5, 0.5, 1.0)), _p("space", SPACE_TANGENT),
                                 _p("attribute", -1)), (_v("Normal", UNLINKED),), False),
 }
+IMAGE_NODES = ("TexImage", "TexEnvironment")     # nodes that read an image (``prop:image``)
 
 # Name of the per-corner tangent attribute of a UV map ("" is the default UV map).
 TANGENT_PREFIX = "tangent:"
@@ -385,6 +430,7 @@ TL_NORMAL = OFFSETS["BsdfTranslucent"]["Normal"]
 S_ROUGHNESS = OFFSETS["BsdfSheen"]["Roughness"]
 S_NORMAL = OFFSETS["BsdfSheen"]["Normal"]
 E_STRENGTH = OFFSETS["Emission"]["Strength"]
+assert OFFSETS["Background"]["Strength"] == E_STRENGTH
 
 K_PRINCIPLED = KIND["BsdfPrincipled"]
 K_DIFFUSE = KIND["BsdfDiffuse"]
@@ -396,4 +442,5 @@ K_TRANSPARENT = KIND["BsdfTransparent"]
 K_SHEEN = KIND["BsdfSheen"]
 K_EMISSION = KIND["Emission"]
 K_HOLDOUT = KIND["Holdout"]
+K_BACKGROUND = KIND["Background"]
 

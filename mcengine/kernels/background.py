@@ -1,0 +1,107 @@
+"""The world as a light: its importance map, sampled by next-event estimation (Cycles'
+kernel/light/background.h, scene/light.cpp).
+
+When the world's Sampling Method is not None and the world gives light, the
+render bakes the world's shader into an equirectangular map of W x H texels
+(``bake_background``: one evaluation at each texel's centre, with no ray-type
+flags, as Cycles bakes it) and builds a 2D distribution over it
+(``mcengine.background``): each texel weighs the mean of its |R|, |G|, |B| times
+sin(theta) of its row centre; ``bg_marginal`` is the CDF over rows,
+``bg_conditional`` the CDF over the columns of each row.
+
+``sample_background`` picks a texel (binary searches) and a point in it
+(linear inversion inside the bin) and returns the direction and its solid-angle
+pdf, p_uv / (2 pi^2 sin theta) with theta of the continuous v;
+``background_pdf`` gives the same pdf for any direction, for the MIS weight of a
+ray that escapes.  The world's radiance itself always comes from its shader
+(``shading.world_radiance``), never from the map.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..jit import device, kernel
+from .light_sampling import pick_light
+from .state import CFG_WORLD_SHADER
+from .svm import ShadingData, eval_shader
+from .svm.image_nodes import direction_to_equirectangular
+
+
+@device
+def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
+    """Radiance the world sends along -d to a ray of direction d with path ``flags``: its
+    constant colour, or its shader run for that direction (Cycles' background shader
+    data: the point is the direction, the normal faces back along the ray)."""
+    if not cfg[CFG_WORLD_SHADER]:
+        return sc.world[0], sc.world[1], sc.world[2]
+    # (Typed as in shading.emission_at, so that the shader is compiled once for both.)
+    sd = ShadingData(dx, dy, dz, -dx, -dy, -dz, -dx, -dy, -dz, -dx, -dy, -dz, False, False,
+                     True, True, False, -1, 0.0, 0.0, np.int32(-1), np.int64(flags), math.inf,
+                     0, 0, 0, 0, 0)
+    w = sc.mat_prog.shape[0] - 1
+    res = eval_shader(sc.svm_ops, sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs,
+                      scratch.cl_light, sd, sc.tex)
+    return res.er, res.eg, res.eb
+
+
+@device
+def equirectangular_direction(u, v):
+    """The direction of point (u, v) of Blender's equirectangular image (v = 0: down)."""
+    phi = math.pi - 2.0 * math.pi * u
+    theta = math.pi - math.pi * v
+    s = math.sin(theta)
+    return s * math.cos(phi), s * math.sin(phi), math.cos(theta)
+
+
+@kernel
+def bake_background(sc, cfg, scratch, out):
+    """The world's radiance at the centre of each texel of ``out`` (H, W, 3)."""
+    h, w = out.shape[0], out.shape[1]
+    for y in range(h):
+        for x in range(w):
+            dx, dy, dz = equirectangular_direction((x + 0.5) / w, (y + 0.5) / h)
+            r, g, b = world_radiance(sc, cfg, scratch, dx, dy, dz, 0)
+            out[y, x, 0], out[y, x, 1], out[y, x, 2] = r, g, b
+
+
+@device
+def sample_background(marginal, conditional, u1, u2):
+    """A direction drawn from the map: (x, y, z, solid-angle pdf); pdf 0 if none."""
+    h = conditional.shape[0]
+    w = conditional.shape[1] - 1
+    y = pick_light(marginal, u1)
+    width = marginal[y + 1] - marginal[y]
+    if width <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0
+    dv = min(max((u1 - marginal[y]) / width, 0.0), 1.0)
+    row = conditional[y]
+    x = pick_light(row, u2)
+    cwidth = row[x + 1] - row[x]
+    if cwidth <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0
+    du = min(max((u2 - row[x]) / cwidth, 0.0), 1.0)
+    u = (x + du) / w
+    v = (y + dv) / h
+    s = math.sin(math.pi * v)
+    if s <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0
+    dx, dy, dz = equirectangular_direction(u, v)
+    pdf = width * h * cwidth * w / (2.0 * math.pi * math.pi * s)
+    return dx, dy, dz, pdf
+
+
+@device
+def background_pdf(marginal, conditional, dx, dy, dz):
+    """Solid-angle pdf with which ``sample_background`` draws direction d."""
+    h = conditional.shape[0]
+    w = conditional.shape[1] - 1
+    u, v = direction_to_equirectangular(dx, dy, dz)
+    s = math.sin(math.pi * v)
+    if s <= 0.0:
+        return 0.0
+    x = min(max(int(u * w), 0), w - 1)
+    y = min(max(int(v * h), 0), h - 1)
+    p = (marginal[y + 1] - marginal[y]) * h * (conditional[y, x + 1] - conditional[y, x]) * w
+    return p / (2.0 * math.pi * math.pi * s)

@@ -270,6 +270,49 @@ def combine_material(name, first, second, fac=None):
 
 
 # --------------------------------------------------------------------------
+# Textures (written next to the scenes, in textures/, and read by relative path)
+# --------------------------------------------------------------------------
+
+TEXTURES_DIR = Path(__file__).resolve().parent / "textures"
+
+
+def save_texture(name, pixels, float_buffer=False):
+    """Write ``pixels`` ((H, W, 4), bottom row first, as Blender stores them) to
+    ``textures/<name>`` (PNG for 8-bit, OpenEXR for float) and load it as an image that
+    the .blend refers to by its relative path."""
+    h, w = pixels.shape[:2]
+    TEXTURES_DIR.mkdir(exist_ok=True)
+    path = TEXTURES_DIR / name
+    image = bpy.data.images.new(name + " (writer)", w, h, alpha=True, float_buffer=float_buffer)
+    image.pixels.foreach_set([float(v) for v in pixels.ravel()])
+    image.filepath_raw = str(path)
+    image.file_format = "OPEN_EXR" if float_buffer else "PNG"
+    if float_buffer:
+        image.use_half_precision = False
+    image.save()
+    bpy.data.images.remove(image)
+    loaded = bpy.data.images.load(str(path))
+    loaded.filepath = "//textures/" + name
+    return loaded
+
+
+def image_texture(tree, image, location=(-300.0, 0.0), **values):
+    """An Image Texture node reading ``image`` (inputs and properties as shader_node)."""
+    node = shader_node(tree, "ShaderNodeTexImage", location=location, **values)
+    node.image = image
+    return node
+
+
+def set_planar_uvs(obj, scale=1.0):
+    """A UV map projecting the object's local X and Y (times ``scale``) onto U and V."""
+    mesh = obj.data
+    layer = mesh.uv_layers.new(name="UVMap")
+    for loop in mesh.loops:
+        co = mesh.vertices[loop.vertex_index].co
+        layer.data[loop.index].uv = (co.x * scale, co.y * scale)
+
+
+# --------------------------------------------------------------------------
 # Objects
 # --------------------------------------------------------------------------
 

@@ -40,6 +40,8 @@ SCENES = (
     "caustics",
     "caustics_point",
     "texture_procedural",
+    "world_hdri_sun",
+    "texture_image",
 )
 
 

@@ -278,20 +278,25 @@ TEXTURES_DIR = Path(__file__).resolve().parent / "textures"
 
 def save_texture(name, pixels, float_buffer=False):
     """Write ``pixels`` ((H, W, 4), bottom row first, as Blender stores them) to
-    ``textures/<name>`` (PNG for 8-bit, OpenEXR for float) and load it as an image that
-    the .blend refers to by its relative path."""
+    ``textures/<name>`` and load it as an image that the .blend refers to by its relative
+    path: 8-bit sRGB PNG through Blender, or a linear 32-bit float OpenEXR written with
+    mcengine's writer (Blender's own EXR save encodes the values with the image's colour
+    space)."""
     h, w = pixels.shape[:2]
     TEXTURES_DIR.mkdir(exist_ok=True)
     path = TEXTURES_DIR / name
-    image = bpy.data.images.new(name + " (writer)", w, h, alpha=True, float_buffer=float_buffer)
-    image.pixels.foreach_set([float(v) for v in pixels.ravel()])
-    image.filepath_raw = str(path)
-    image.file_format = "OPEN_EXR" if float_buffer else "PNG"
     if float_buffer:
-        image.use_half_precision = False
-    image.save()
-    bpy.data.images.remove(image)
+        from mcengine.imageio import write_exr
+        write_exr(path, pixels[::-1])
+    else:
+        image = bpy.data.images.new(name + " (writer)", w, h, alpha=True)
+        image.pixels.foreach_set([float(v) for v in pixels.ravel()])
+        image.filepath_raw = str(path)
+        image.file_format = "PNG"
+        image.save()
+        bpy.data.images.remove(image)
     loaded = bpy.data.images.load(str(path))
+    loaded.colorspace_settings.name = "Linear Rec.709" if float_buffer else "sRGB"
     loaded.filepath = "//textures/" + name
     return loaded
 

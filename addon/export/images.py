@@ -29,6 +29,8 @@ def export_image(ctx, image) -> str:
     """Add ``image`` to ``ctx.images`` once; its name there ("" when it cannot be read)."""
     if image is None:
         return ""
+    # The original data-block: an evaluated copy may lack the pixels set from Python.
+    image = getattr(image, "original", None) or image
     key = image.name_full
     if key in ctx.images:
         return key

@@ -22,6 +22,7 @@ def _image(name, float_buffer=False, colorspace="sRGB", alpha_mode="STRAIGHT"):
     img = bpy.data.images.new(name, 3, 2, alpha=True, float_buffer=float_buffer)
     px = np.arange(24, dtype=np.float32).reshape(2, 3, 4) / 23.0
     img.pixels.foreach_set(px.ravel())
+    img.pack()              # (an unpacked generated image is regenerated blank when rendered)
     img.colorspace_settings.name = colorspace
     img.alpha_mode = alpha_mode
     return img, px
@@ -56,10 +57,12 @@ def test_unsupported_colour_space_is_read_as_srgb_with_a_warning(scene, fake_ses
 
 
 def test_float_image_is_linear_with_associated_alpha(scene, fake_session):
-    img, px = _image("hdr", float_buffer=True)
+    img, px = _image("hdr", float_buffer=True, colorspace="Linear Rec.709")
     _textured_plane(img)
     im = export_scene(fake_session).images["hdr"]
-    assert im.pixels.dtype == np.float32 and np.allclose(im.pixels, px)
+    associated = px.copy()
+    associated[..., :3] *= px[..., 3:]        # Blender's float buffer holds associated alpha
+    assert im.pixels.dtype == np.float32 and np.allclose(im.pixels, associated, atol=1e-6)
     assert (im.colorspace, im.alpha) == ("linear", "PREMUL")
 
 

@@ -10,6 +10,9 @@
   MurmurHash3_32 values.
 * Denoising albedo and normal: the first non-specular surface's albedo, also
   seen through a mirror (times its colour), and the normal in camera space.
+* A textured world (Environment Texture, sampled with its map): the sky's
+  radiance goes to Environment and the denoising albedo, its light on a plane to
+  Diffuse Direct, and the light passes still recompose Combined.
 """
 import math
 
@@ -23,6 +26,7 @@ from mcengine.scene import (
     Denoising,
     Film,
     Geometry,
+    Image,
     Integrator,
     Light,
     Link,
@@ -110,6 +114,52 @@ def test_light_passes_follow_the_film_exposure():
                                rtol=1e-6)
     np.testing.assert_allclose(b.pass_image("Emission"), 2 * before["Emission"], rtol=1e-6)
     np.testing.assert_array_equal(b.pass_image("Diffuse Color"), before["Diffuse Color"])
+
+
+def _textured_world_scene(res=16, samples=16):
+    """A grey-blue plane to the horizon under a world whose colour varies with the azimuth
+    (an Environment Texture of a ramp, importance-sampled), seen by a level camera: the
+    top half of the frame is sky."""
+    w, h = 32, 16
+    sky = np.ones((h, w, 4), np.float32)
+    sky[..., 0] = 0.2 + np.linspace(0.0, 1.0, w)[None, :]
+    sky[..., 1] = 0.5
+    sky[..., 2] = 1.0 - 0.5 * np.linspace(0.0, 1.0, w)[None, :]
+    world = World(nodes=[ShaderNode("TexEnvironment", props={"image": "sky"}),
+                         ShaderNode("Background", {"Color": Link(0, "Color"), "Strength": 1.0})],
+                  surface=Link(1, "Background"), sampling="MANUAL", map_resolution=64)
+    return SceneDescription(
+        geometry=Geometry.from_triangles(grid_plane(200.0), object_names=["Plane"]),
+        materials=[Material(base_color=(0.3, 0.5, 0.7))],
+        camera=Camera(matrix_world=translation(0.0, 0.0, 1.0) @ _rot_x(math.pi / 2)),
+        world=world, images={"sky": Image(sky, "linear", "PREMUL")},
+        film=Film(width=res, height=res, filter_type="BOX", filter_width=1.0),
+        integrator=Integrator(samples=samples, max_bounces=1),
+        passes=RenderPasses(enabled=ALL, denoising_data=True))
+
+
+def test_textured_world_in_the_environment_pass_and_the_denoising_guides():
+    s = render(_textured_world_scene())
+    combined = s.image()[..., :3].astype(np.float64)
+    env, albedo = s.pass_image("Environment"), s.pass_image("Denoising Albedo")
+    # Sky (rows above the horizon): Combined is the world's radiance, all of it in
+    # Environment and in the albedo guide (Cycles adds the background there), no normal.
+    sky = slice(0, 8)
+    np.testing.assert_allclose(env[sky], combined[sky], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(albedo[sky], combined[sky], rtol=1e-5, atol=1e-7)
+    assert np.all(s.pass_image("Denoising Normal")[sky] == 0.0)
+    assert np.ptp(env[sky][..., 0]) > 0.05 and np.ptp(env[sky][..., 2]) > 0.02   # it varies
+    # Ground (rows well below the horizon): lit by the world through Diffuse Direct.
+    ground = slice(10, 16)
+    assert np.all(env[ground] == 0.0)
+    np.testing.assert_allclose(albedo[ground], np.broadcast_to([0.3, 0.5, 0.7], (6, 16, 3)),
+                               rtol=1e-5)
+    assert s.pass_image("Diffuse Direct")[ground].min() > 0.1
+    total = s.pass_image("Emission").astype(np.float64) + env
+    for group in LIGHT_GROUPS:
+        light = s.pass_image(f"{group} Direct").astype(np.float64) + s.pass_image(f"{group} Indirect")
+        total += light * s.pass_image(f"{group} Color")
+    np.testing.assert_allclose(total, combined, rtol=2e-4, atol=2e-5)
 
 
 def _plane_scene(height=4.0, ortho=True, albedo=(0.3, 0.5, 0.7), res=8, samples=4, **passes):

@@ -36,10 +36,13 @@ def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
     data: the point is the direction, the normal faces back along the ray)."""
     if not cfg[CFG_WORLD_SHADER]:
         return sc.world[0], sc.world[1], sc.world[2]
-    # (Typed as in shading.emission_at, so that the shader is compiled once for both.)
-    sd = ShadingData(dx, dy, dz, -dx, -dy, -dz, -dx, -dy, -dz, -dx, -dy, -dz, False, False,
-                     True, True, False, -1, 0.0, 0.0, np.int32(-1), np.int64(flags), math.inf,
-                     0, 0, 0, 0, 0)
+    # Every field of the type shading.shading_data gives it (float64, bool, int64), so that
+    # the shader evaluator is compiled once for surfaces and the world.
+    i64 = np.int64
+    x, y, z = float(dx), float(dy), float(dz)
+    sd = ShadingData(x, y, z, -x, -y, -z, -x, -y, -z, -x, -y, -z, False, False, True, True, False,
+                     i64(-1), 0.0, 0.0, i64(-1), i64(flags), math.inf,
+                     i64(0), i64(0), i64(0), i64(0), i64(0))
     w = sc.mat_prog.shape[0] - 1
     res = eval_shader(sc.svm_ops, sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs,
                       scratch.cl_light, sd, sc.tex)

@@ -29,7 +29,11 @@ mean, as a check that all rendered the same scene.
 With ``--materials principled`` every surface is the default Principled BSDF
 (roughness 0.5, Specular IOR Level 0.5, Multiscatter GGX) of its base colour,
 the material a Blender user starts from (Mitsuba's ``principled`` plugin is
-only approximately the same BSDF).
+only approximately the same BSDF).  With ``--materials textured`` every surface is that
+Principled BSDF with an image texture (256 x 256, 8-bit sRGB, packed) as Base Color and a
+tangent-space normal map (256 x 256, Non-Color) through a Normal Map node, on each face's
+0..1 UVs: what a textured asset costs per hit (Mitsuba is left out: its peer scene is built
+from constant materials).
 
 Mitsuba comes from the optional ``bench`` extra (``pip install -e '.[bench]'``);
 drjit needs a libLLVM >= 16, found on its own or named by DRJIT_LIBLLVM_PATH.
@@ -39,7 +43,7 @@ and Cycles' path counts do not depend on it); ``benchmarks/bench_sampler.py``
 compares the samplers' error per second.
 
 Run: python benchmarks/bench_cornell.py [--samples N] [--resolution N] [--rounds R]
-                                        [--materials file|principled] [--no-mitsuba]
+                                        [--materials file|principled|textured] [--no-mitsuba]
                                         [--sampler sobol|independent]
 """
 from __future__ import annotations
@@ -66,7 +70,7 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=128)
     ap.add_argument("--resolution", type=int, default=256)
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--materials", choices=("file", "principled"), default="file",
+    ap.add_argument("--materials", choices=("file", "principled", "textured"), default="file",
                     help="the file's Lambert materials, or every surface the default Principled "
                          "BSDF of the same base colour (the light keeps its emission)")
     ap.add_argument("--sampler", choices=samplers.NAMES, default=samplers.DEFAULT,
@@ -74,6 +78,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-mitsuba", action="store_true",
                     help="leave Mitsuba 3 out (it needs the 'bench' extra: pip install -e '.[bench]')")
     args = ap.parse_args(argv)
+    args.no_mitsuba = args.no_mitsuba or args.materials == "textured"
     if not args.no_mitsuba:
         try:
             import mitsuba  # noqa: F401
@@ -106,8 +111,10 @@ def main(argv=None) -> int:
         scene = open_scene(SCENE)
         make_unbiased(scene)
         scene.mcengine.sampler = samplers.get(args.sampler).enum_id
-        if args.materials == "principled":
+        if args.materials in ("principled", "textured"):
             to_default_principled(bpy)
+        if args.materials == "textured":
+            to_textured(bpy)
         return render_scene(scene, bl_engine, samples=samples, seed=0, resolution=res)
 
     # Warm-up: load numba's kernel cache and Cycles' kernels once.
@@ -212,6 +219,47 @@ def print_agreement(images: dict) -> None:
             block = np.abs(blocks(im) - blocks(ours)).max() / blocks(ours).mean()
             line += f"  frame {100 * rel:+.1f} %, worst block {100 * block:.1f} % of the mean"
         print(line)
+
+
+def _packed_image(bpy, name: str, pixels: np.ndarray, colorspace: str):
+    h, w = pixels.shape[:2]
+    image = bpy.data.images.new(name, w, h, alpha=True)
+    image.colorspace_settings.name = colorspace
+    image.pixels.foreach_set(np.ascontiguousarray(pixels, np.float32).ravel())
+    image.pack()
+    return image
+
+
+def to_textured(bpy, size: int = 256) -> None:
+    """Feed every Principled BSDF an image texture as Base Color and a normal map (tiles with
+    bevelled edges), on UVs that map each face to 0..1."""
+    y, x = (np.mgrid[0:size, 0:size] + 0.5) / size * 8.0         # 8 x 8 tiles
+    fx, fy = x - np.floor(x) - 0.5, y - np.floor(y) - 0.5
+    tile = (np.floor(x) + np.floor(y)) % 2
+    albedo = np.stack([0.25 + 0.5 * tile, 0.3 + 0.3 * tile, 0.2 + 0.4 * (1 - tile),
+                       np.ones_like(tile)], axis=-1)
+    slope = 4.0 * np.clip(np.abs(np.stack([fx, fy])) - 0.35, 0.0, None) * np.sign(np.stack([fx, fy]))
+    n = np.stack([-slope[0], -slope[1], np.ones_like(fx)], axis=-1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    normal = np.concatenate([0.5 + 0.5 * n, np.ones_like(tile)[..., None]], axis=-1)
+    color_image = _packed_image(bpy, "bench_albedo", albedo, "sRGB")
+    normal_image = _packed_image(bpy, "bench_normal", normal, "Non-Color")
+    for ob in bpy.data.objects:
+        if ob.type == "MESH" and not ob.data.uv_layers:
+            ob.data.uv_layers.new(name="UVMap")
+    for material in bpy.data.materials:
+        tree = material.node_tree
+        for node in list(tree.nodes) if tree else ():
+            if node.bl_idname != "ShaderNodeBsdfPrincipled":
+                continue
+            tex = tree.nodes.new("ShaderNodeTexImage")
+            tex.image = color_image
+            tree.links.new(tex.outputs["Color"], node.inputs["Base Color"])
+            ntex = tree.nodes.new("ShaderNodeTexImage")
+            ntex.image = normal_image
+            nmap = tree.nodes.new("ShaderNodeNormalMap")
+            tree.links.new(ntex.outputs["Color"], nmap.inputs["Color"])
+            tree.links.new(nmap.outputs["Normal"], node.inputs["Normal"])
 
 
 def to_default_principled(bpy) -> None:

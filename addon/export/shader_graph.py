@@ -26,7 +26,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from mcengine.kernels.svm.nodes import NODES, SHADER_ROUTING
+from mcengine.kernels.svm.nodes import NODES, RAMP_TABLE_SIZE, SHADER_ROUTING
 from mcengine.scene import Link, ShaderNode
 
 __all__ = ["GraphReader", "label", "node_type", "source", "SPECIAL_PROPS"]
@@ -67,12 +67,45 @@ def _image_props(node, ctx) -> dict:
     return {"image": export_image(ctx, node.image)}
 
 
+def _ramp_props(node, ctx) -> dict:
+    """ColorRamp: baked as Cycles bakes it (colorramp_to_array): RGBA at i / 256, i = 0..256,
+    evaluated by Blender in the ramp's own interpolation and colour mode."""
+    ramp = node.color_ramp
+    table = [v for i in range(RAMP_TABLE_SIZE + 1) for v in ramp.evaluate(i / RAMP_TABLE_SIZE)]
+    return {"interpolate": 0.0 if ramp.interpolation == "CONSTANT" else 1.0, "table": table}
+
+
+def _curve_props(curves: int, combined: bool):
+    """A curve node's table as Cycles bakes it (curvemapping_*_to_array): over the x range
+    from the first to the last point of all its curves, 257 samples of each curve (RGB
+    Curves: each channel's curve applied to the combined curve's value)."""
+    def props(node, ctx) -> dict:
+        mapping = node.mapping
+        mapping.initialize()
+        maps = list(mapping.curves)
+        lo = min(m.points[0].location[0] for m in maps[:curves + (1 if combined else 0)])
+        hi = max(m.points[-1].location[0] for m in maps[:curves + (1 if combined else 0)])
+        table = []
+        for i in range(RAMP_TABLE_SIZE + 1):
+            x = lo + i / RAMP_TABLE_SIZE * (hi - lo)
+            if combined:
+                x = mapping.evaluate(maps[3], x)
+            table.extend(mapping.evaluate(maps[k], x) for k in range(curves))
+        return {"min_x": lo, "max_x": hi, "table": table,
+                "extrapolate": 1.0 if mapping.extend == "EXTRAPOLATED" else 0.0}
+    return props
+
+
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
 # ramps, curves), which the generic property copy cannot.
 SPECIAL_PROPS = {
     "TexCoord": _tex_coord_props,
     "TexImage": _image_props,
     "TexEnvironment": _image_props,
+    "ValToRGB": _ramp_props,
+    "RGBCurve": _curve_props(3, True),
+    "VectorCurve": _curve_props(3, False),
+    "FloatCurve": _curve_props(1, False),
 }
 
 

@@ -32,6 +32,7 @@ import numpy as np
 
 from ...jit import device, function
 from .closure_nodes import eval_closure_node
+from .color_nodes import eval_color_node
 from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ATTR_DEFAULT_UV,
@@ -50,7 +51,15 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
 from .image_nodes import eval_image_node
 from .input_nodes import eval_input_node
 from .math_nodes import eval_math_node
-from .nodes import FAMILY_INPUT, FAMILY_MATH, FAMILY_NORMAL, FAMILY_TEXTURE, FAMILY_VECTOR, IMAGE_CODES
+from .nodes import (
+    FAMILY_COLOR,
+    FAMILY_INPUT,
+    FAMILY_MATH,
+    FAMILY_NORMAL,
+    FAMILY_TEXTURE,
+    FAMILY_VECTOR,
+    IMAGE_CODES,
+)
 from .normal_nodes import eval_normal_node
 from .texture_nodes import eval_texture_node
 from .vector_nodes import eval_vector_node
@@ -84,6 +93,8 @@ def eval_node(code, regs, b, c, sd, tex):
         eval_input_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_MATH:
         eval_math_node(code, regs, b, c, sd, tex)
+    elif family == FAMILY_COLOR:
+        eval_color_node(code, regs, b, c, sd, tex)
     elif family == FAMILY_TEXTURE:
         if code >= IMAGE_CODES:
             eval_image_node(code, regs, b, c, sd, tex)

@@ -81,6 +81,35 @@ WAVE_TYPES = {"BANDS": 0, "RINGS": 1}
 WAVE_BANDS_DIRECTIONS = {"X": 0, "Y": 1, "Z": 2, "DIAGONAL": 3}
 WAVE_RINGS_DIRECTIONS = {"X": 0, "Y": 1, "Z": 2, "SPHERICAL": 3}
 WAVE_PROFILES = {"SIN": 0, "SAW": 1, "TRI": 2}
+# Blend modes of the Mix node (colour) and of the legacy MixRGB (the ``blend_type`` property).
+MIX_BLEND = 0
+MIX_ADD = 1
+MIX_MULTIPLY = 2
+MIX_SUBTRACT = 3
+MIX_SCREEN = 4
+MIX_DIVIDE = 5
+MIX_DIFFERENCE = 6
+MIX_DARKEN = 7
+MIX_LIGHTEN = 8
+MIX_OVERLAY = 9
+MIX_DODGE = 10
+MIX_BURN = 11
+MIX_HUE = 12
+MIX_SATURATION = 13
+MIX_VALUE = 14
+MIX_COLOR = 15
+MIX_SOFT_LIGHT = 16
+MIX_LINEAR_LIGHT = 17
+MIX_EXCLUSION = 18
+BLEND_TYPES = {"MIX": MIX_BLEND, "ADD": MIX_ADD, "MULTIPLY": MIX_MULTIPLY, "SUBTRACT": MIX_SUBTRACT,
+               "SCREEN": MIX_SCREEN, "DIVIDE": MIX_DIVIDE, "DIFFERENCE": MIX_DIFFERENCE,
+               "DARKEN": MIX_DARKEN, "LIGHTEN": MIX_LIGHTEN, "OVERLAY": MIX_OVERLAY,
+               "DODGE": MIX_DODGE, "BURN": MIX_BURN, "HUE": MIX_HUE, "SATURATION": MIX_SATURATION,
+               "VALUE": MIX_VALUE, "COLOR": MIX_COLOR, "SOFT_LIGHT": MIX_SOFT_LIGHT,
+               "LINEAR_LIGHT": MIX_LINEAR_LIGHT, "EXCLUSION": MIX_EXCLUSION}
+FACTOR_UNIFORM = 0
+FACTOR_NON_UNIFORM = 1
+FACTOR_MODES = {"UNIFORM": FACTOR_UNIFORM, "NON_UNIFORM": FACTOR_NON_UNIFORM}
 
 # Enum properties: property name -> {Blender's identifier: code}.  A node's enum inputs
 # ("prop:<name>") are encoded with the table of that name.
@@ -121,7 +150,11 @@ OPERATIONS = {name: k for k, name in enumerate((
 MAP_RANGE_INTERPOLATIONS = {"LINEAR": 0, "STEPPED": 1, "SMOOTHSTEP": 2, "SMOOTHERSTEP": 3}
 # ``data_type``: which sockets are in use (Map Range: FLOAT, FLOAT_VECTOR; Mix: FLOAT, VECTOR,
 # RGBA).  Tables are per property name, so nodes sharing a property name share its table.
-DATA_TYPES = {"FLOAT": 0, "FLOAT_VECTOR": 1, "VECTOR": 2, "RGBA": 3}
+DATA_TYPES = {"FLOAT": 0, "FLOAT_VECTOR": 1, "VECTOR": 2, "RGBA": 3,
+              "ROTATION": 0}       # Cycles mixes rotations as floats (MixFloatNode)
+DATA_FLOAT = DATA_TYPES["FLOAT"]
+DATA_VECTOR = DATA_TYPES["VECTOR"]
+DATA_RGBA = DATA_TYPES["RGBA"]
 CLAMP_TYPES = {"MINMAX": 0, "RANGE": 1}
 # Separate / Combine Color: the colour model of the three channels.
 COLOR_MODES = {"RGB": 0, "HSV": 1, "HSL": 2}
@@ -164,6 +197,8 @@ ENUMS = {
     "interpolation": INTERPOLATIONS,
     "extension": EXTENSIONS,
     "projection": PROJECTIONS,
+    "blend_type": BLEND_TYPES,
+    "factor_mode": FACTOR_MODES,
 }
 
 WHITE = (1.0, 1.0, 1.0)
@@ -180,6 +215,14 @@ POSITION = "position"          # the point (world shaders: the ray direction)
 IMPLICIT = {GENERATED: ("TexCoord", "Generated"), UV: ("TexCoord", "UV"),
             POSITION: ("NewGeometry", "Position")}
 
+# Baked tables of the ColorRamp and curve nodes: Cycles samples them at RAMP_TABLE_SIZE + 1
+# evenly spaced positions (blender/util.h: colorramp_to_array, curvemapping_*_to_array).
+RAMP_TABLE_SIZE = 256
+_RAMP_X = [i / RAMP_TABLE_SIZE for i in range(RAMP_TABLE_SIZE + 1)]
+DEFAULT_RAMP = tuple(v for x in _RAMP_X for v in (x, x, x, 1.0))     # black to white, RGBA
+IDENTITY_CURVE = tuple(_RAMP_X)
+IDENTITY_CURVES = tuple(v for x in _RAMP_X for v in (x, x, x))
+
 
 def _f(name, default):
     return Socket(name, FLOAT, float(default))
@@ -195,6 +238,16 @@ def _v(name, default=UNLINKED):
 
 def _p(name, default):
     return Socket("prop:" + name, FLOAT, float(default))
+
+
+def _table(default):
+    return Socket("prop:table", TABLE, default)
+
+
+def _curve(fac, value, out, default):
+    """A curve node: factor, input, the curve's x range and extrapolation, its baked table."""
+    return NodeSpec(0, (fac, value, _p("min_x", 0.0), _p("max_x", 1.0), _p("extrapolate", 0),
+                        _table(default)), (out,), True)
 
 
 _BSDF = (Socket("BSDF", SHADER, None),)
@@ -295,6 +348,34 @@ VALUE_NODES = {
     "RGBToBW": NodeSpec(209, (_c("Color", (0.5, 0.5, 0.5)),), (_f("Val", 0.0),), True),
     "Blackbody": NodeSpec(210, (_f("Temperature", 6500.0),), (_c("Color", (0, 0, 0)),), True),
     "Wavelength": NodeSpec(211, (_f("Wavelength", 500.0),), (_c("Color", (0, 0, 0)),), True),
+    # -- colour family
+    "Mix": NodeSpec(301, (_f("Factor_Float", 0.5), _v("Factor_Vector", (0.5, 0.5, 0.5)),
+                          _f("A_Float", 0.0), _f("B_Float", 0.0), _v("A_Vector", (0, 0, 0)),
+                          _v("B_Vector", (0, 0, 0)), _c("A_Color", (0.5, 0.5, 0.5)),
+                          _c("B_Color", (0.5, 0.5, 0.5)), _p("data_type", DATA_FLOAT),
+                          _p("factor_mode", FACTOR_UNIFORM), _p("blend_type", MIX_BLEND),
+                          _p("clamp_factor", 1), _p("clamp_result", 0)),
+                    (_f("Result_Float", 0.0), _v("Result_Vector", (0, 0, 0)),
+                     _c("Result_Color", (0, 0, 0))), True),
+    "MixRGB": NodeSpec(302, (_f("Fac", 0.5), _c("Color1", (0.5, 0.5, 0.5)),
+                             _c("Color2", (0.5, 0.5, 0.5)), _p("blend_type", MIX_BLEND),
+                             _p("use_clamp", 0)), (_c("Color", (0, 0, 0)),), True),
+    "ValToRGB": NodeSpec(303, (_f("Fac", 0.5), _p("interpolate", 1), _table(DEFAULT_RAMP)),
+                         (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), True),
+    "RGBCurve": _curve(_f("Fac", 1.0), _c("Color", WHITE), _c("Color", (0, 0, 0)),
+                       IDENTITY_CURVES)._replace(code=304),
+    "VectorCurve": _curve(_f("Fac", 1.0), _v("Vector", (0, 0, 0)), _v("Vector", (0, 0, 0)),
+                          IDENTITY_CURVES)._replace(code=305),
+    "FloatCurve": _curve(_f("Factor", 1.0), _f("Value", 1.0), _f("Value", 0.0),
+                         IDENTITY_CURVE)._replace(code=306),
+    "HueSaturation": NodeSpec(307, (_f("Hue", 0.5), _f("Saturation", 1.0), _f("Value", 1.0),
+                                    _f("Fac", 1.0), _c("Color", GREY)), (_c("Color", (0, 0, 0)),),
+                              True),
+    "Invert": NodeSpec(308, (_f("Fac", 1.0), _c("Color", (0, 0, 0))), (_c("Color", (0, 0, 0)),),
+                       True),
+    "BrightContrast": NodeSpec(309, (_c("Color", WHITE), _f("Bright", 0.0), _f("Contrast", 0.0)),
+                               (_c("Color", (0, 0, 0)),), True),
+    "Gamma": NodeSpec(310, (_c("Color", WHITE), _f("Gamma", 1.0)), (_c("Color", (0, 0, 0)),), True),
     # -- texture family
     "TexChecker": NodeSpec(401, (_v("Vector", GENERATED), _c("Color1", (0.8, 0.8, 0.8)),
                                  _c("Color2", (0.2, 0.2, 0.2)), _f("Scale", 5.0)),

@@ -75,8 +75,11 @@ from .kernels.svm.nodes import (
 )
 from .scene import Link, Material, SceneError, ShaderNode
 
-__all__ = ["AttributeLayout", "Program", "compile_material", "ShaderTable"]
+__all__ = ["AttributeLayout", "DEFAULT_COLOR_ATTRIBUTE", "Program", "compile_material", "ShaderTable"]
 
+# The name under which a mesh's default colour attribute (Blender's render colour) is also
+# stored: what a Color Attribute node with no name reads, as Cycles' ATTR_STD_VERTEX_COLOR.
+DEFAULT_COLOR_ATTRIBUTE = ".default color"
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
 # Inputs whose constant values decide whether a closure node can emit or let light through.
 _EMISSION_INPUTS = {"Emission": ("Color", "Strength"),
@@ -164,19 +167,22 @@ class _Compiler:
 
     def compile(self) -> Program:
         if self.surface is not None:
-            self.shader(self.surface, NO_WEIGHT)
+            self.shader(self.surface, NO_WEIGHT, False)
         return self.program
 
     def error(self, message: str) -> SceneError:
         return SceneError(f"material '{self.material.name}': {message}")
 
     # -- closures ---------------------------------------------------------------------------------
-    def shader(self, link: Link, weight_reg: int) -> None:
+    def shader(self, link: Link, weight_reg: int, varies: bool) -> None:
+        """Compile the closures ``link`` leads to, weighted by ``weight_reg``; ``varies``: that
+        weight depends on the point (a Mix Shader factor on the way is linked)."""
         node = self.node(link)
         if node.type in SHADER_ROUTING:
             self.path += (link.node,)
             if node.type == "MixShader":
                 fac = self.input(node, SHADER_ROUTING["MixShader"].inputs[0])
+                varies = varies or not fac.constant
                 fac_reg = fac.reg if not fac.constant else self.program.store(fac.const)
                 out = self.program.reg(2)
                 self.program.ops.append([OP_MIX_WEIGHT, fac_reg, weight_reg, out])
@@ -186,7 +192,7 @@ class _Compiler:
             for name, w in zip(("Shader", "Shader_001"), weights):
                 shader_in = node.inputs.get(name)
                 if isinstance(shader_in, Link):
-                    self.shader(shader_in, w)
+                    self.shader(shader_in, w, varies)
             self.path = self.path[:-1]
             return
         spec = CLOSURES.get(node.type)
@@ -197,12 +203,18 @@ class _Compiler:
         values = [self.input(node, socket) for socket in spec.inputs]
         base = self.block(spec.inputs, values)
         self.program.ops.append([OP_CLOSURE, spec.code, base, weight_reg])
-        for name, value in zip((s.name for s in spec.inputs), values):
-            if not value.constant:
-                if name in _EMISSION_INPUTS.get(node.type, ()):
-                    self.program.emission_varies = True
-                if name in _TRANSPARENCY_INPUTS.get(node.type, ()):
-                    self.program.transparency_varies = True
+        # What emits or lets light through differently from point to point (or from ray to
+        # ray: a Light Path factor) is evaluated where a light sample or a shadow ray meets it.
+        named = dict(zip((s.name for s in spec.inputs), values))
+        emission = [named[name] for name in _EMISSION_INPUTS.get(node.type, ())]
+        if any(not v.constant for v in emission) or (
+                varies and emission and all(any(v.const) for v in emission)):
+            self.program.emission_varies = True
+        transparency = [named[name] for name in _TRANSPARENCY_INPUTS.get(node.type, ())]
+        opaque = (1.0,) if node.type == "BsdfPrincipled" else (0.0, 0.0, 0.0)   # alpha 1, black
+        if any(not v.constant for v in transparency) or (
+                varies and transparency and transparency[0].const != opaque):
+            self.program.transparency_varies = True
 
     # -- values -----------------------------------------------------------------------------------
     def node(self, link: Link):
@@ -293,9 +305,13 @@ class _Compiler:
         return outputs
 
     def attribute_inputs(self, node, spec, values) -> list:
-        """The attribute a UV Map, Attribute or Normal Map node reads, found by name."""
+        """The attribute a UV Map, Attribute, Color Attribute or Normal Map node reads, found by
+        name (a Color Attribute without one reads the mesh's default colour attribute)."""
         prefix, prop = _ATTRIBUTE_READERS[node.type]
-        offset, size = self.attributes.find(prefix + str(node.props.get(prop, "")))
+        name = str(node.props.get(prop, ""))
+        if node.type == "VertexColor" and not name:
+            name = DEFAULT_COLOR_ATTRIBUTE
+        offset, size = self.attributes.find(prefix + name)
         names = [s.name for s in spec.inputs]
         values[names.index("prop:attribute")] = Value(FLOAT, (float(offset),))
         if "prop:attribute_size" in names:
@@ -365,7 +381,7 @@ class _Compiler:
 # Nodes that read a per-corner attribute: type -> (prefix of the attribute's name, the
 # property naming it); the attribute's offset goes to their "prop:attribute" input.
 _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map"),
-                      "NormalMap": (TANGENT_PREFIX, "uv_map")}
+                      "VertexColor": ("", "layer_name"), "NormalMap": (TANGENT_PREFIX, "uv_map")}
 
 
 # What the compiler shows a node it evaluates ahead of time: no point, no scene.

@@ -86,6 +86,7 @@ def convert_material(ctx, material) -> Material:
     if out is None:
         return Material(name=name, base_color=BLACK, **settings)
     graph = _MaterialGraph(ctx)
+    graph.pass_index = float(getattr(material, "pass_index", 0))
     for socket_name, what in (("Volume", "volume"), ("Displacement", "displacement")):
         src = linked_node(out.inputs[socket_name])
         if src is not None:
@@ -104,6 +105,8 @@ def convert_material(ctx, material) -> Material:
 class _MaterialGraph(GraphReader):
     """A material's graph: the generic copy, plus the shader nodes rendered through others."""
 
+    pass_index = 0.0      # the material's pass index (Object Info's Material Index)
+
     def convert(self, node, groups) -> ShaderNode:
         kind = node.bl_idname
         if kind == "ShaderNodeBsdfMetallic":
@@ -114,6 +117,8 @@ class _MaterialGraph(GraphReader):
             return ShaderNode("BsdfDiffuse", {"Color": self._in(node, "Color", "color", groups)},
                               name=node.name)
         copied = super().convert(node, groups)
+        if copied.type == "ObjectInfo":
+            copied.props["material_index"] = self.pass_index
         if copied.type == "BsdfSheen" and node.distribution == "ASHIKHMIN":
             self.note(f"{label(node)} Ashikhmin velvet sheen", "velvet sheen",
                       "microfibre sheen used")

@@ -29,6 +29,9 @@ import numpy as np
 
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
+from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
+
+from .settings import hash_uint2
 
 __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances"]
 
@@ -153,7 +156,8 @@ class MeshCollector:
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
-            self._infos[key].append([float(inst.random_id & 0xFFFFFFFF), float(ob.pass_index),
+            random_id = inst.random_id if inst.is_instance else object_random_id(ob.name)
+            self._infos[key].append([float(random_id & 0xFFFFFFFF), float(ob.pass_index),
                                      *(float(c) for c in ob.color)])
             self._passes[key].append(object_pass_info(ob))
 
@@ -442,6 +446,15 @@ _ATTRIBUTE_TYPES = {"FLOAT": 1, "INT": 1, "BOOLEAN": 1, "INT8": 1, "FLOAT2": 2, 
 _VALUE_FIELD = {1: "value", 2: "vector", 3: "vector", 4: "color"}
 
 
+def object_random_id(name: str) -> int:
+    """The random id Cycles gives an object that is not an instance (blender/object.cpp):
+    hash_uint2 of the hash of the object's name (a signed-char string hash) and 0."""
+    h = 0
+    for byte in name.encode("utf-8"):
+        h = (h * 37 + (byte - 256 if byte >= 128 else byte)) & 0xFFFFFFFF
+    return hash_uint2(h, 0)
+
+
 def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
     """Every UV map and colour attribute, and the wanted generic attributes, of the
     triangle corners: name -> CornerTable of C components.  Byte colours come out linear
@@ -471,6 +484,9 @@ def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
             field_name = _VALUE_FIELD[size]
         values = _get(attr.data, field_name, np.float32, count * size).reshape(count, size)
         out[name] = CornerTable(values, domain)
+    default = getattr(me.color_attributes, "default_color_name", "")
+    if default in colors and default in out:
+        out[DEFAULT_COLOR_ATTRIBUTE] = out[default]
     return out
 
 

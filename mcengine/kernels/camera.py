@@ -271,6 +271,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.transparent[n] = 0
             st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | (PF_FIRST_SAMPLE if sample == 0 else 0)
             st.mis_pdf[n] = 0.0
+            st.mis_p[n, 0], st.mis_p[n, 1], st.mis_p[n, 2] = ox, oy, oz   # ray length from here
             st.min_pdf[n] = math.inf
             st.self_prim[n] = -1
             st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz

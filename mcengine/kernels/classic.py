@@ -189,9 +189,9 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
             continue   # a terminated path only collects emission, and there is none
+        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
-                          (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i],
-                           st.transparent[i]))
+                          depths)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,
                                flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,
@@ -221,7 +221,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                 lkey = mix64(key ^ (np.uint64(li + 1) * _K_LIGHT))
                 lu, lv, _, _ = sample_4d(SAMPLER_INDEPENDENT, lkey, SET_LIGHT, _NO_MASK)
                 n_shadow = direct_light(sc, cfg, fcfg, stats, sq, n_shadow, acc, root, st.beta, i,
-                                        scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
+                                        scratch, ncl, sp, dx, dy, dz, idx, pmf, depths, lu, lv,
                                         nee_mis, float(branching),
                                         cfg[CFG_MAX_TRANSPARENT] - st.transparent[i])
         if not spawn:

@@ -192,23 +192,25 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
             continue   # a terminated path only collects emission, and there is none
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
-                          (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i],
-                           st.transparent[i]))
+        # The ray's length from the vertex it left (transparent surfaces may lie between):
+        # Light Path's Ray Length and the emission's MIS distance.
+        hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
+        ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
+        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
+                          not terminate, depths)
 
         # Holdout: the film's alpha drops by the holdout weight on camera paths.
         if res.holdout > 0.0 and (flags & PF_TRANSPARENT_BG):
             st.transparency[i] += res.holdout * (st.beta[i, 0] + st.beta[i, 1] + st.beta[i, 2]) / 3.0
             if res.holdout >= 1.0:
                 continue
-        # Emission (two-sided); the distance for its MIS weight is from the vertex the
-        # ray left (transparent surfaces may lie between).
+        # Emission (two-sided).
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
-            hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
             if light_passes:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
-                               math.sqrt(hx * hx + hy * hy + hz * hz), sp.cos_o, flags, mis_pdf,
+                               ray_length, sp.cos_o, flags, mis_pdf,
                                pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
@@ -259,7 +261,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
                 queued = n_shadow
             n_shadow = direct_light(sc, cfg, fcfg, stats, sq, n_shadow, st.radiance, i, st.beta, i,
-                                    scratch, ncl, sp, dx, dy, dz, idx, pmf, bounce, lu, lv,
+                                    scratch, ncl, sp, dx, dy, dz, idx, pmf, depths, lu, lv,
                                     True, 1.0, max_transparent - st.transparent[i])
             if split:
                 _nee_passes(pd, fp, st, pb, i, scratch, ncl, -dx, -dy, -dz, bounce, flags,

@@ -73,10 +73,11 @@ from .state import (
     MF_EMISSION_VARIES,
     PF_CAMERA,
     PF_DIFFUSE,
+    PF_EMISSION,
     PF_GLOSSY,
     PF_MIS_SKIP,
     PF_REFLECT,
-    PF_SHADOW,
+    PF_SINGULAR,
     PF_TERMINATE,
     PF_TRANSMIT,
     PF_TRANSPARENT,
@@ -133,14 +134,15 @@ def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tm
 
 @device
 def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb,
-                transparent_left):
+                transparent_left, depths):
     """Queue a shadow ray from the shading point ``sp`` towards the light point.
 
     Returns the new queue length.  Both ends leave their surfaces (pbrt's
     SpawnRayTo): the direction is re-aimed from the offset origin at the offset
     target, else at grazing angles the shifted ray meets the emitter's plane
     before its end.  ``owner`` is the row the light goes to if unoccluded;
-    ``transparent_left`` is how many transparent surfaces the ray may pass.
+    ``transparent_left`` is how many transparent surfaces the ray may pass;
+    ``depths`` the path's bounce counts (what a Light Path node on the way sees).
     """
     hx, hy, hz = sp.hx, sp.hy, sp.hz
     sox, soy, soz = offset_origin(hx, hy, hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
@@ -165,6 +167,9 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
     sq.target[n_shadow, 0], sq.target[n_shadow, 1], sq.target[n_shadow, 2] = ex, ey, ez
     sq.transparent[n_shadow] = transparent_left
     sq.alive[n_shadow] = 1
+    for k in range(5):
+        sq.depths[n_shadow, k] = depths[k]
+    sq.travelled[n_shadow] = 0.0
     return n_shadow + 1
 
 
@@ -172,14 +177,14 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
 def next_path_flags(flags, label):
     """Path flags after a BSDF sample with ``label`` (Cycles' path_state_next)."""
     new = flags & ~(PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | PF_TRANSPARENT | PF_DIFFUSE |
-                    PF_GLOSSY | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
+                    PF_GLOSSY | PF_SINGULAR | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
     new |= PF_REFLECT if label & LABEL_REFLECT else PF_TRANSMIT
     if label & LABEL_DIFFUSE:
         new |= PF_DIFFUSE
     elif label & LABEL_GLOSSY:
         new |= PF_GLOSSY
     else:   # singular: a glossy ray for light visibility, no MIS at its hit
-        new |= PF_GLOSSY | PF_MIS_SKIP
+        new |= PF_GLOSSY | PF_SINGULAR | PF_MIS_SKIP
     return new
 
 
@@ -281,8 +286,9 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
 @device
 def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
-    direction d and length t_hit, on a path with ``flags`` and ``depths`` (bounces: all,
-    diffuse, glossy, transmission, transparent).
+    direction d and length t_hit (from the vertex it left, through transparent surfaces, as
+    Cycles measures it), on a path with ``flags`` and ``depths`` (bounces: all, diffuse,
+    glossy, transmission, transparent).
 
     The closures go to ``scratch.cl``; returns the ``ShaderResult``.  With
     ``allocate`` false only emission, transparency and holdout are computed.
@@ -298,14 +304,16 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
 
 
 @device
-def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist):
+def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths):
     """Radiance emitted by triangle ``tri`` at barycentrics (b1, b2) towards a ray of
     direction d and length dist that reaches it there (a light sample of a material whose
-    emission varies over the surface: its shader runs there, without closures)."""
+    emission varies over the surface: its shader runs there, without closures, as Cycles
+    evaluates a light sample: path flag "emission", the bounce counts ``depths`` of the
+    path sampling it)."""
     m = sc.mat_index[tri]
     sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, tri, b1, b2, dx, dy, dz)
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
-                      sc.tex.tri_object[tri], PF_SHADOW, dist, (0, 0, 0, 0, 0))
+                      sc.tex.tri_object[tri], PF_EMISSION, dist, depths)
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                       scratch.cl_light, sd, sc.tex)
     return res.er, res.eg, res.eb
@@ -324,7 +332,8 @@ def emission_estimates(sc, scratch, tris, out):
         for k in range(4):
             b1, b2 = points[k]
             er, eg, eb = emission_at(sc, scratch, t, b1, b2, -sc.tri_normal[t, 0],
-                                     -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0)
+                                     -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0,
+                                     (0, 0, 0, 0, 0))
             r += er
             g += eg
             b += eb
@@ -360,7 +369,7 @@ def world_light_sample(sc, cfg, scratch, pmf, u1, u2):
 
 @device
 def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch, ncl, sp, dx, dy, dz,
-                 idx, pmf, bounce, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
+                 idx, pmf, depths, u1, u2, mis_on, bsdf_pdf_scale, transparent_left):
     """Light from light ``idx`` (picked with probability ``pmf``) scattered at ``sp`` by
     the ``ncl`` closures in ``scratch.cl`` towards the viewer (-d).  Lights are the lamps,
     then the emissive triangles, then the world (``world_light_sample``).
@@ -368,12 +377,14 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     The light is added to ``out[row]`` at once if the light casts no shadow,
     else queued behind a shadow ray owned by ``row``; returns the queue length.
     With ``mis_on`` the power heuristic weighs it against BSDF sampling, whose
-    pdf is scaled by ``bsdf_pdf_scale`` (the number of BSDF rays per hit).  The
+    pdf is scaled by ``bsdf_pdf_scale`` (the number of BSDF rays per hit).  ``depths``
+    are the path's bounce counts (all, diffuse, glossy, transmission, transparent).  The
     light's direction and the closure labels it excludes go to ``scratch.light`` (4,), for
     render passes.
     """
     if pmf <= 0.0:
         return n_shadow
+    bounce = depths[0]
     if idx == sc.lamps.shape[0] + sc.emit_tri.shape[0]:
         ls = world_light_sample(sc, cfg, scratch, pmf, u1, u2)
     else:
@@ -384,7 +395,8 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     scratch.light[3] = ls.exclude
     lr, lg, lb = ls.lr, ls.lg, ls.lb
     if ls.tri >= 0 and (sc.mat_flags[sc.mat_index[ls.tri]] & MF_EMISSION_VARIES):
-        er, eg, eb = emission_at(sc, scratch, ls.tri, ls.b1, ls.b2, ls.wix, ls.wiy, ls.wiz, ls.dist)
+        er, eg, eb = emission_at(sc, scratch, ls.tri, ls.b1, ls.b2, ls.wix, ls.wiy, ls.wiz, ls.dist,
+                                 depths)
         lr, lg, lb = er / ls.pdf, eg / ls.pdf, eb / ls.pdf
     if lr == 0.0 and lg == 0.0 and lb == 0.0:   # (lights may be negative)
         return n_shadow
@@ -400,7 +412,7 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
     if ls.cast_shadow:
         return push_shadow(sq, n_shadow, row, sp, ls.wix, ls.wiy, ls.wiz, ls.dist,
-                           ls.lnx, ls.lny, ls.lnz, cr, cg, cb, transparent_left)
+                           ls.lnx, ls.lny, ls.lnz, cr, cg, cb, transparent_left, depths)
     out[row, 0] += cr
     out[row, 1] += cg
     out[row, 2] += cb

@@ -72,8 +72,12 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         if not math.isfinite(t):
             t = 0.0
         sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t, PF_SHADOW, False,
-                          (0, 0, 0, 0, 0))
+        # Light Path sees a shadow ray from the shading point, with the path's bounces and
+        # the transparent surfaces passed so far (Cycles' shadow path state).
+        dep = sq.depths[s]
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, sq.travelled[s] + t,
+                          PF_SHADOW, False, (dep[0], dep[1], dep[2], dep[3], dep[4]))
+        dep[4] += 1
         sq.contrib[s, 0] *= res.tr
         sq.contrib[s, 1] *= res.tg
         sq.contrib[s, 2] *= res.tb
@@ -83,6 +87,7 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         sq.transparent[s] -= 1
         # On from just past the surface, towards the same end point.
         k = t + offset_scale(sp.hx, sp.hy, sp.hz) * 4.0
+        sq.travelled[s] += k
         nox, noy, noz = ox + k * dx, oy + k * dy, oz + k * dz
         sq.o32[s, 0], sq.o32[s, 1], sq.o32[s, 2] = nox, noy, noz
         if math.isfinite(sq.target[s, 0]):

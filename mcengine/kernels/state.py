@@ -48,6 +48,10 @@ ShadowQueue = namedtuple("ShadowQueue", [
     "target",              # (B, 3) f64  end point of the ray (transparent shadows re-aim at it)
     "transparent",         # (B,) int32  transparent bounces the path may still make
     "alive",               # (B,) uint8  still being traced (transparent shadows)
+    "depths",              # (B, 5) int32  the path's bounces when the ray left (all, diffuse,
+                           #               glossy, transmission, transparent; transparent
+                           #               surfaces passed add to the last: Light Path node)
+    "travelled",           # (B,) f64    distance from the shading point to the current origin
 ])
 
 Scratch = namedtuple("Scratch", [
@@ -108,6 +112,8 @@ PF_SURFACE_PASS = 1024    # scattered once: light goes to the diffuse/glossy/tra
 PF_PASS_DONE = 2048       # normal and UV written for this sample (Cycles' PATH_RAY_SINGLE_PASS_DONE)
 PF_DENOISE = 4096         # denoising albedo and normal not written yet
 PF_FIRST_SAMPLE = 8192    # the pixel's first sample (depth, position, indices come from it)
+PF_SINGULAR = 16384       # the ray was made by a singular (perfectly sharp) lobe
+PF_EMISSION = 32768       # shading a light sample's emission (Cycles' PATH_RAY_EMISSION)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -174,7 +180,8 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
     return ShadowQueue(o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
                        t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
                        path=np.zeros(n, np.int32), target=np.zeros((n, 3)),
-                       transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8))
+                       transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
+                       depths=np.zeros((n, 5), np.int32), travelled=np.zeros(n))
 
 
 def alloc_scratch(sc: SceneData) -> Scratch:

@@ -6,6 +6,8 @@ import bpy
 import numpy as np
 import pytest
 
+from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
+
 from .helpers import CUBE_FACES, CUBE_VERTS, export_scene, new_mesh_object
 
 TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
@@ -332,7 +334,10 @@ def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, a
     g = export_scene(fake_session).geometry
     grid_tris = 5 * 2 * n * n
     assert g.triangles.shape == (grid_tris + 12, 3)
-    assert set(g.attributes) == {"UVMap", "Second", "Col", "PCol", "weight"}
+    # The mesh's default colour attribute (the first made, "Col") also under the name a
+    # Color Attribute node without one reads.
+    assert set(g.attributes) == {"UVMap", "Second", "Col", "PCol", "weight", DEFAULT_COLOR_ATTRIBUTE}
+    np.testing.assert_array_equal(g.attributes[DEFAULT_COLOR_ATTRIBUTE], g.attributes["Col"])
     for block, (arrays, names) in exports.items():
         assert names == exports[1 << 20][1]
         for name, a, b in zip(fields + tuple(names[1]), arrays, exports[1 << 20][0]):

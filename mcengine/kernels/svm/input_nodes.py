@@ -1,17 +1,32 @@
 """Input nodes: what the shading point offers the graph (kernel/svm/tex_coord.h, geometry.h,
-attribute.h, value.h).
+attribute.h, vertex_color.h, fresnel.h, light_path.h, camera.h, value.h).
 
-Texture Coordinate, UV Map, Attribute and Geometry read the point
-(``ShadingData``) and the scene's per-corner attributes and per-object data
+Texture Coordinate, UV Map, Attribute, Color Attribute, Geometry, Object
+Info, Camera Data, Fresnel, Layer Weight and Light Path read the point
+(``ShadingData``: its path flags, ray length and bounce counts for Light
+Path) and the scene's per-corner attributes and per-object data
 (``TextureData``); Value and RGB are constants (the compiler folds them, so
 they only run here when evaluated ahead of time).  Every output of a node is
 computed, each into its registers (``nodes.OUTPUT_OFFSETS``).
 """
 from __future__ import annotations
 
+import math
+
 from ...jit import device, function
 from ..camera import C_FWD, C_HALF_H, C_HALF_W, C_POS, C_RIGHT, C_SHIFT_X, C_SHIFT_Y, C_TYPE, C_UP, CAM_ORTHO
-from .data import ATTR_DEFAULT_UV, OBJ_INVERSE, OBJ_MATRIX, OBJ_TEXSPACE_LOC, OBJ_TEXSPACE_SIZE
+from ..closures.fresnel import fresnel_dielectric
+from ..state import PF_CAMERA, PF_DIFFUSE, PF_EMISSION, PF_GLOSSY, PF_REFLECT, PF_SHADOW, PF_SINGULAR, PF_TRANSMIT
+from .data import (
+    ATTR_DEFAULT_UV,
+    OBJ_COLOR,
+    OBJ_INVERSE,
+    OBJ_MATRIX,
+    OBJ_PASS_INDEX,
+    OBJ_RANDOM,
+    OBJ_TEXSPACE_LOC,
+    OBJ_TEXSPACE_SIZE,
+)
 from .math_nodes import safe_normalize
 from .nodes import NODES, OFFSETS
 
@@ -26,6 +41,20 @@ _TC_INVERSE = OFFSETS["TexCoord"]["prop:object_inverse"]
 _UV_ATTRIBUTE = OFFSETS["UVMap"]["prop:attribute"]
 _ATTR_OFFSET = OFFSETS["Attribute"]["prop:attribute"]
 _ATTR_SIZE = OFFSETS["Attribute"]["prop:attribute_size"]
+_FRESNEL = NODES["Fresnel"].code
+_LAYER_WEIGHT = NODES["LayerWeight"].code
+_LIGHT_PATH = NODES["LightPath"].code
+_OBJECT_INFO = NODES["ObjectInfo"].code
+_CAMERA_DATA = NODES["CameraData"].code
+_VERTEX_COLOR = NODES["VertexColor"].code
+_FR_IOR = OFFSETS["Fresnel"]["IOR"]
+_FR_NORMAL = OFFSETS["Fresnel"]["Normal"]
+_LW_BLEND = OFFSETS["LayerWeight"]["Blend"]
+_LW_NORMAL = OFFSETS["LayerWeight"]["Normal"]
+_OI_MATERIAL_INDEX = OFFSETS["ObjectInfo"]["prop:material_index"]
+_VC_OFFSET = OFFSETS["VertexColor"]["prop:attribute"]
+_VC_SIZE = OFFSETS["VertexColor"]["prop:attribute_size"]
+_RANDOM_SCALE = 1.0 / 4294967295.0       # Object Info Random: the object's 32-bit random id
 
 
 @function
@@ -40,6 +69,29 @@ def eval_input_node(code, regs, b, c, sd, tex):
         attribute_node(regs, b, c, sd, tex)
     elif code == _GEOMETRY:
         geometry(regs, c, sd)
+    elif code == _FRESNEL or code == _LAYER_WEIGHT:
+        fresnel_nodes(code, regs, b, c, sd)
+    elif code == _LIGHT_PATH:
+        light_path(regs, c, sd)
+    elif code == _OBJECT_INFO:
+        object_info(regs, b, c, sd, tex)
+    elif code == _CAMERA_DATA:
+        cx, cy, cz = camera_space(tex.camera, sd.px, sd.py, sd.pz)
+        dist = math.sqrt(cx * cx + cy * cy + cz * cz)
+        vx, vy, vz = safe_normalize(cx, cy, cz)
+        _store3(regs, c, vx, vy, vz)
+        regs[c + 3] = cz
+        regs[c + 4] = dist
+    elif code == _VERTEX_COLOR:
+        off = int(regs[b + _VC_OFFSET])
+        size = int(regs[b + _VC_SIZE])
+        x, y, z, w = attribute(tex, sd, off, size)
+        if off < 0 or sd.prim < 0:
+            w = 0.0
+        elif size != 4:
+            w = 1.0
+        _store3(regs, c, x, y, z)
+        regs[c + 3] = w
     elif code == _VALUE:
         regs[c] = regs[b]
     elif code == _RGB:
@@ -107,6 +159,15 @@ def normal_to_world(row, x, y, z):
 
 
 @device
+def camera_space(cam, px, py, pz):
+    """A world point in camera space: +X right, +Y up, +Z forward, from the camera."""
+    dx, dy, dz = px - cam[C_POS], py - cam[C_POS + 1], pz - cam[C_POS + 2]
+    return (dx * cam[C_RIGHT] + dy * cam[C_RIGHT + 1] + dz * cam[C_RIGHT + 2],
+            dx * cam[C_UP] + dy * cam[C_UP + 1] + dz * cam[C_UP + 2],
+            dx * cam[C_FWD] + dy * cam[C_FWD + 1] + dz * cam[C_FWD + 2])
+
+
+@device
 def tex_coord(regs, b, c, sd, tex):
     """Texture Coordinate: Generated, Normal, UV, Object, Camera, Window, Reflection."""
     px, py, pz = sd.px, sd.py, sd.pz
@@ -129,12 +190,8 @@ def tex_coord(regs, b, c, sd, tex):
     if regs[b + _TC_USE_OBJECT] != 0.0:
         ox, oy, oz = transform_point(regs, b + _TC_INVERSE, px, py, pz)
     u, v, _z, _w = attribute(tex, sd, ATTR_DEFAULT_UV, 2)
-    # Camera space: +X right, +Y up, +Z forward, from the camera's position.
     cam = tex.camera
-    dx, dy, dz = px - cam[C_POS], py - cam[C_POS + 1], pz - cam[C_POS + 2]
-    cx = dx * cam[C_RIGHT] + dy * cam[C_RIGHT + 1] + dz * cam[C_RIGHT + 2]
-    cy = dx * cam[C_UP] + dy * cam[C_UP + 1] + dz * cam[C_UP + 2]
-    cz = dx * cam[C_FWD] + dy * cam[C_FWD + 1] + dz * cam[C_FWD + 2]
+    cx, cy, cz = camera_space(cam, px, py, pz)
     # Window: normalized device coordinates, (0, 0) bottom left, (1, 1) top right.
     if cam[C_TYPE] == CAM_ORTHO:
         vx, vy = cx, cy
@@ -186,3 +243,76 @@ def geometry(regs, c, sd):
     _store3(regs, c + 12, sd.wox, sd.woy, sd.woz)
     _store3(regs, c + 15, 1.0 - sd.u - sd.v, sd.u, 0.0)
     _store3(regs, c + 18, 1.0 if sd.backfacing else 0.0, 0.5, 0.0)
+
+
+@device
+def fresnel_nodes(code, regs, b, c, sd):
+    """Fresnel (Fac) and Layer Weight (Fresnel, Facing) about the Normal input (unlinked:
+    the shading normal), seen from the viewer."""
+    k = b + (_FR_NORMAL if code == _FRESNEL else _LW_NORMAL)
+    nx, ny, nz = regs[k], regs[k + 1], regs[k + 2]
+    if nx == 0.0 and ny == 0.0 and nz == 0.0:
+        nx, ny, nz = sd.nx, sd.ny, sd.nz
+    cos_i = sd.wox * nx + sd.woy * ny + sd.woz * nz
+    if code == _FRESNEL:
+        eta = max(regs[b + _FR_IOR], 1e-5)
+        if sd.backfacing:
+            eta = 1.0 / eta
+        regs[c] = fresnel_dielectric(cos_i, eta)[0]
+        return
+    blend = regs[b + _LW_BLEND]
+    eta = max(1.0 - blend, 1e-5)
+    if not sd.backfacing:
+        eta = 1.0 / eta
+    regs[c] = fresnel_dielectric(cos_i, eta)[0]
+    f = abs(cos_i)
+    if blend != 0.5:
+        blend = min(max(blend, 0.0), 1.0 - 1e-5)
+        f = f ** (2.0 * blend if blend < 0.5 else 0.5 / (1.0 - blend))
+    regs[c + 1] = 1.0 - f
+
+
+@device
+def _flag(flags, bit):
+    return 1.0 if flags & bit else 0.0
+
+
+@device
+def light_path(regs, c, sd):
+    """Light Path: the kind of ray that reached the point, its length and the bounces so far
+    (one more for shadow rays and light samples, as Cycles counts them)."""
+    f = sd.path_flags
+    regs[c] = _flag(f, PF_CAMERA)
+    regs[c + 1] = _flag(f, PF_SHADOW)
+    regs[c + 2] = _flag(f, PF_DIFFUSE)
+    regs[c + 3] = _flag(f, PF_GLOSSY)
+    regs[c + 4] = _flag(f, PF_SINGULAR)
+    regs[c + 5] = _flag(f, PF_REFLECT)
+    regs[c + 6] = _flag(f, PF_TRANSMIT)
+    regs[c + 7] = 0.0                       # volume scattering: no volumes
+    regs[c + 8] = sd.ray_length
+    regs[c + 9] = sd.depth + (1.0 if f & (PF_SHADOW | PF_EMISSION) else 0.0)
+    regs[c + 10] = sd.diffuse_depth
+    regs[c + 11] = sd.glossy_depth
+    regs[c + 12] = sd.transparent_depth
+    regs[c + 13] = sd.transmission_depth
+    regs[c + 14] = 0.0                      # portals: none
+
+
+@device
+def object_info(regs, b, c, sd, tex):
+    """Object Info: the object's location, colour, alpha, pass index, random number, and the
+    material's pass index (zeros without an object, as for the world)."""
+    regs[c + 8] = regs[b + _OI_MATERIAL_INDEX]
+    ob = sd.obj
+    if ob < 0 or sd.prim < 0:
+        for k in range(8):
+            regs[c + k] = 0.0
+        regs[c + 9] = 0.0
+        return
+    row = tex.objects[ob]
+    _store3(regs, c, row[OBJ_MATRIX + 3], row[OBJ_MATRIX + 7], row[OBJ_MATRIX + 11])
+    _store3(regs, c + 3, row[OBJ_COLOR], row[OBJ_COLOR + 1], row[OBJ_COLOR + 2])
+    regs[c + 6] = row[OBJ_COLOR + 3]
+    regs[c + 7] = row[OBJ_PASS_INDEX]
+    regs[c + 9] = row[OBJ_RANDOM] * _RANDOM_SCALE

@@ -309,6 +309,11 @@ FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump
 # Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
 # of the single-output coordinate nodes the compiler inserts for implicit inputs).
 TEX_COORD_OUTPUTS = ("Generated", "Normal", "UV", "Object", "Camera", "Window", "Reflection")
+# Light Path outputs, in register order.
+LIGHT_PATH_OUTPUTS = ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ray",
+                      "Is Singular Ray", "Is Reflection Ray", "Is Transmission Ray",
+                      "Is Volume Scatter Ray", "Ray Length", "Ray Depth", "Diffuse Depth",
+                      "Glossy Depth", "Transparent Depth", "Transmission Depth", "Portal Depth")
 
 VALUE_NODES = {
     # -- input family
@@ -324,6 +329,18 @@ VALUE_NODES = {
                                       _v("True Normal"), _v("Incoming"), _v("Parametric"),
                                       _f("Backfacing", 0.0), _f("Pointiness", 0.0),
                                       _f("Random Per Island", 0.0)), False),
+    "Fresnel": NodeSpec(107, (_f("IOR", 1.5), _v("Normal")), (_f("Fac", 0.0),), False),
+    "LayerWeight": NodeSpec(108, (_f("Blend", 0.5), _v("Normal")),
+                            (_f("Fresnel", 0.0), _f("Facing", 0.0)), False),
+    "LightPath": NodeSpec(109, (), tuple(_f(name, 0.0) for name in LIGHT_PATH_OUTPUTS), False),
+    "ObjectInfo": NodeSpec(110, (_p("material_index", 0),),
+                           (_v("Location"), _c("Color", (0, 0, 0)), _f("Alpha", 0.0),
+                            _f("Object Index", 0.0), _f("Material Index", 0.0),
+                            _f("Random", 0.0)), False),
+    "CameraData": NodeSpec(111, (), (_v("View Vector"), _f("View Z Depth", 0.0),
+                                     _f("View Distance", 0.0)), False),
+    "VertexColor": NodeSpec(112, (_p("attribute", -1), _p("attribute_size", 0)),
+                            (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), False),
     # -- math family: converters (svm/math_nodes.py)
     "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
                            _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),

@@ -159,12 +159,17 @@ def normal_to_world(row, x, y, z):
 
 
 @device
+def camera_axes(cam, x, y, z):
+    """(x, y, z) on the camera's axes: right, up, forward (Cycles' camera space)."""
+    return (x * cam[C_RIGHT] + y * cam[C_RIGHT + 1] + z * cam[C_RIGHT + 2],
+            x * cam[C_UP] + y * cam[C_UP + 1] + z * cam[C_UP + 2],
+            x * cam[C_FWD] + y * cam[C_FWD + 1] + z * cam[C_FWD + 2])
+
+
+@device
 def camera_space(cam, px, py, pz):
     """A world point in camera space: +X right, +Y up, +Z forward, from the camera."""
-    dx, dy, dz = px - cam[C_POS], py - cam[C_POS + 1], pz - cam[C_POS + 2]
-    return (dx * cam[C_RIGHT] + dy * cam[C_RIGHT + 1] + dz * cam[C_RIGHT + 2],
-            dx * cam[C_UP] + dy * cam[C_UP + 1] + dz * cam[C_UP + 2],
-            dx * cam[C_FWD] + dy * cam[C_FWD + 1] + dz * cam[C_FWD + 2])
+    return camera_axes(cam, px - cam[C_POS], py - cam[C_POS + 1], pz - cam[C_POS + 2])
 
 
 @device

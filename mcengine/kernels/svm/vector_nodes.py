@@ -11,7 +11,14 @@ import math
 from ...jit import device, function
 from ..camera import C_FWD, C_POS, C_RIGHT, C_UP
 from .data import OBJ_INVERSE, OBJ_MATRIX
-from .input_nodes import normal_to_object, normal_to_world, transform_direction, transform_point
+from .input_nodes import (
+    camera_axes,
+    camera_space,
+    normal_to_object,
+    normal_to_world,
+    transform_direction,
+    transform_point,
+)
 from .math_nodes import safe_divide, safe_normalize
 from .nodes import NODES, OFFSETS, TRANSFORM_SPACES, VECTOR_TYPES
 
@@ -83,18 +90,10 @@ def mapping_node(regs, b, c):
 
 
 @device
-def _camera_axes(cam, x, y, z):
-    """(x, y, z) on the camera's axes: right, up, forward (Cycles' camera space)."""
-    return (x * cam[C_RIGHT] + y * cam[C_RIGHT + 1] + z * cam[C_RIGHT + 2],
-            x * cam[C_UP] + y * cam[C_UP + 1] + z * cam[C_UP + 2],
-            x * cam[C_FWD] + y * cam[C_FWD + 1] + z * cam[C_FWD + 2])
-
-
-@device
 def _world_to_camera(cam, kind, x, y, z):
     if kind == _POINT:
-        return _camera_axes(cam, x - cam[C_POS], y - cam[C_POS + 1], z - cam[C_POS + 2])
-    x, y, z = _camera_axes(cam, x, y, z)
+        return camera_space(cam, x, y, z)
+    x, y, z = camera_axes(cam, x, y, z)
     if kind == _NORMAL:
         return safe_normalize(x, y, z)
     return x, y, z

@@ -205,6 +205,8 @@ class MCEngine(bpy.types.RenderEngine):
             return None, None
         if not self.is_preview:
             _store_effects(depsgraph.scene.original, session.plan, exported.ignored)
+            for warning in session.warnings:
+                self.report({"WARNING"}, warning)
         return exported.scene, session
 
     def _publish(self, result, session, progress) -> None:

@@ -17,8 +17,8 @@ world lookups        the world is not black                   background radianc
 transparent shadows  a material lets shadow rays through      shadow rays traced hit by hit, with the
                                                               shader run at every surface they pass
 caustic paths        lights, a glossy/glass/refraction caster Filter Glossy and the caustics switches
-                     and a diffuse receiver                   at every vertex; light subpaths of
-                                                              bidirectional path tracing
+                     and a diffuse receiver                   at every vertex; the light paths of
+                                                              Path + Light Tracing
 ==================== ======================================== ======================================
 
 Besides the effects, the plan lists what the scene holds: light types, the

@@ -2,7 +2,11 @@
 
 Each finished path adds its radiance (and alpha) to its pixel's sums; the
 image is the per-pixel mean, so pixels may hold different sample counts (an
-interrupted pass, adaptive sampling).  The sum of squares gives each pixel's
+interrupted pass, adaptive sampling).  Light tracing (``kernels.light_tracing``)
+adds light to whichever pixels a light path reaches: ``splat`` sums it and
+``light_paths`` counts the light paths traced, each an estimate of the whole
+image, so the image adds ``splat / light_paths`` (which ``variance`` does not
+see).  The sum of squares gives each pixel's
 sample variance, from which ``variance()`` estimates the variance of the
 pixel mean.  Memory is proportional to the film region, never to samples:
 ``memory.FILM_BYTES_PER_PIXEL`` for the sums, and read-out works through
@@ -11,7 +15,9 @@ float32 image it returns.
 
 Render passes other than Combined accumulate in ``passes``, one row of
 ``pass_stride`` float64 sums per pixel (``mcengine.passes`` lays them out and
-reads them); a render without passes has none.
+reads them); a render without passes has none.  Light tracing's ``splat`` is
+Combined's only: ``pass_image`` does not add it (the add-on writes passes for
+the path tracer alone).
 """
 from __future__ import annotations
 
@@ -32,6 +38,16 @@ class Film:
         # Render passes' sums (kernels.passes); one column when there are none, so the
         # kernels see the same array type either way.
         self.passes = np.zeros((n if pass_stride else 1, max(int(pass_stride), 1)))
+        self.splat = None                    # (n, 3) light-tracing sums, once a light path ran
+        self.light_paths = 0                 # light paths traced into ``splat``
+
+    def add_splats(self, splat, light_paths: int) -> None:
+        """Add a worker's light-tracing sums (then zeroed) over ``light_paths`` light paths."""
+        if self.splat is None:
+            self.splat = np.zeros((self.count.size, 3))
+        self.splat += splat
+        splat[:] = 0.0
+        self.light_paths += int(light_paths)
 
     @property
     def arrays(self):
@@ -54,6 +70,8 @@ class Film:
         for r0, r1 in self._row_blocks():
             a, b = r0 * w, r1 * w
             block = self.sum[a:b] / np.maximum(self.count[a:b], 1)[:, None]
+            if self.splat is not None and self.light_paths:
+                block[:, :3] += self.splat[a:b] / self.light_paths
             block[:, :3] *= exposure
             rows = block.reshape(r1 - r0, w, 4)
             if bottom_up:

@@ -8,8 +8,11 @@ reads: ``depth`` (ray levels, the camera ray being level 1) and ``branching``
 (secondary rays per hit).  ``rays_per_sample`` is the lecture's count of
 closest-hit rays one camera sample can cast at most.
 
-The path tracer is the default and the only integrator that matches Cycles;
-the others are the lecture's classic algorithms (``mcengine.kernels.classic``).
+The path tracer is the default and matches Cycles; Path + Light Tracing adds
+light tracing for the caustics path tracing cannot find (``mcengine.kernels.
+light_tracing``: point and spot lamps of radius 0 through sharp glass and in
+sharp mirrors) and is otherwise path tracing; the others are the lecture's
+classic algorithms (``mcengine.kernels.classic``).
 """
 from __future__ import annotations
 
@@ -26,7 +29,7 @@ DEFAULT_BRANCHING = 4
 
 @dataclass(frozen=True)
 class IntegratorInfo:
-    name: str              # "path", "raycast", "whitted", "distribution"
+    name: str              # "path", "light", "raycast", "whitted", "distribution"
     enum_id: str           # Blender enum identifier
     label: str
     description: str
@@ -39,6 +42,8 @@ class IntegratorInfo:
     # The integrator whose images it renders exactly on a scene without mirrors or
     # glass (nothing for its extra rays to follow), or "".
     reduces_to: str = ""
+    # Runs light tracing beside path tracing (``kernels.light_tracing``).
+    light_tracing: bool = False
 
     @property
     def uses_sampler(self) -> bool:
@@ -92,6 +97,13 @@ INTEGRATORS = {info.name: info for info in (
                    "1 + b + ... + b^(depth-1) rays per sample", True, True, False, 3,
                    leaves_out="its ray tree stops at the depth, so light that needs more "
                               "bounces is missing"),
+    IntegratorInfo("light", "PATH_LIGHT", "Path + Light Tracing",
+                   "Path tracing, and light tracing joined to the camera for the caustics that "
+                   "rays from the camera cannot find: point and spot lamps of radius 0 through "
+                   "sharp glass and in sharp mirrors", False, False, False, 0,
+                   leaves_out="path + light tracing is unbiased: a plateau means the reference is "
+                              "not converged enough or the two differ",
+                   light_tracing=True),
 )}
 NAMES = tuple(INTEGRATORS)
 DEFAULT = "path"

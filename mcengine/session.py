@@ -36,7 +36,7 @@ from .adaptive import Adaptive
 from .denoise import denoise
 from .film import Film
 from .integrators import get as integrator_info
-from .kernels import classic, path
+from .kernels import classic, light_tracing, path
 from .kernels.classic import WHITTED_RAYS
 from .kernels.passes import P_DENOISING_ALBEDO, P_DENOISING_NORMAL, PC_DENOISE, PC_LIGHT, alloc_pass_buffers
 from .kernels.state import (
@@ -219,9 +219,14 @@ class _Buffers:
 class _Worker:
     """One worker thread's buffers, counters and timers for one render."""
 
-    def __init__(self, buffers, accel, sc):
+    def __init__(self, buffers, accel, sc, splat_pixels=0):
         self.buffers = buffers
         self.scratch = alloc_scratch(sc)       # closures and shader registers of this scene
+        # Light tracing: a second scratch (a vertex shaded for the camera), the film its
+        # light paths add to (the film region's pixels) and how many it traced.
+        self.cam_scratch = alloc_scratch(sc) if splat_pixels else None
+        self.splat = np.zeros((splat_pixels, 3)) if splat_pixels else None
+        self.light_paths = 0
         self.stats = np.zeros(ST_SIZE, np.int64)
         self.embree_clock = [0.0]
         self.busy = 0.0
@@ -247,6 +252,11 @@ class RenderSession:
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
         self.stats.texture_bytes = int(self.sc.tex.pix8.nbytes + self.sc.tex.pixf.nbytes)
         self.integrator = integrator_info(it.name)
+        self.warnings = []             # what this integrator renders differently, in words
+        self.light_tables = None       # light tracing's lamps (``kernels.light_tracing``)
+        if self.integrator.light_tracing:
+            self.light_tables, self.warnings = light_tracing.prepare(scene, self.sc, self.cfg,
+                                                                     self.plan)
         self._classic_setup()
         guides = ((P_DENOISING_ALBEDO,) if scene.denoising.uses_albedo else ()) + \
             ((P_DENOISING_NORMAL,) if scene.denoising.uses_normal else ())
@@ -256,6 +266,8 @@ class RenderSession:
         self._path_passes = bool(self.pd.cfg[PC_LIGHT]
                                  or self.pd.cfg[PC_DENOISE])
         x0, y0, x1, y1 = scene.film.window
+        if self.light_tables is not None:
+            host_bytes_per_pixel += self.threads * 3 * 8     # the workers' light-tracing films
         self._check_memory((x1 - x0) * (y1 - y0), host_bytes_per_pixel)
         self.film = Film(x1 - x0, y1 - y0, self.pass_layout.stride)
         self.adaptive = Adaptive.from_settings(it)
@@ -338,6 +350,7 @@ class RenderSession:
                         f.result()   # re-raise worker errors here
                     if futures and self._stopping(should_stop, t_start, time_limit):
                         self._stop.set()
+                self._merge_splats()
                 if not self._stop.is_set():
                     self.pass_samples += k
                     if self.adaptive is not None:
@@ -371,6 +384,17 @@ class RenderSession:
     @property
     def _classic(self) -> bool:
         return self.integrator.kernel_code != 0
+
+    def _merge_splats(self):
+        """Light tracing's pixels of this pass into the film (the workers are idle now)."""
+        if self.light_tables is None:
+            return
+        with self._lock:
+            workers = list(self._all_workers)
+        for w in workers:
+            if w.light_paths:
+                self.film.add_splats(w.splat, w.light_paths)
+                w.light_paths = 0
 
     def _classic_setup(self):
         """Chunk size of the classic integrators: their widest ray generation must fit the batch."""
@@ -441,9 +465,11 @@ class RenderSession:
         w = getattr(self._workers, "w", None)
         if w is None:
             w = _Worker(_Buffers.take(self.batch_size, self._classic, self._path_passes), self.accel,
-                        self.sc)
+                        self.sc, self._splat_pixels)
             self._workers.w = w
             scratch = sum(a.nbytes for a in w.scratch)
+            if w.splat is not None:
+                scratch += sum(a.nbytes for a in w.cam_scratch) + w.splat.nbytes
             self._buffer_bytes = max(self._buffer_bytes, self.threads * (w.buffers.nbytes + scratch))
             with self._lock:
                 self._all_workers.append(w)
@@ -451,6 +477,12 @@ class RenderSession:
 
     def _trace_with(self, w, pixels, spp, film, pass_film):
         b = w.buffers
+        if self.light_tables is not None:
+            # Light paths first: their keys come from the samples' numbers before the
+            # camera paths count them (film[2]).
+            w.light_paths += light_tracing.trace_light_chunk(
+                pixels, spp, film[2], w.accel, self.sc, self.cfg, b.state, b.shadow, w.scratch,
+                w.cam_scratch, self.light_tables, w.splat, w.stats)
         if not self._classic:
             path.trace_chunk(pixels, spp, w.accel, self.sc, self.cfg, self.fcfg, b.state, b.shadow,
                              w.scratch, film, w.stats, self.pd, b.passes, pass_film)
@@ -472,8 +504,15 @@ class RenderSession:
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
         size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self._classic else 64
         scratch_film = Film(1, 1, self.pass_layout.stride)
-        self._trace_with(_Worker(_Buffers(size, self._classic, self._path_passes), self.accel, self.sc),
+        self._trace_with(_Worker(_Buffers(size, self._classic, self._path_passes), self.accel, self.sc,
+                                 self._splat_pixels),
                          np.zeros(1, np.int32), 1, scratch_film.arrays, scratch_film.passes)
+
+    @property
+    def _splat_pixels(self) -> int:
+        """Pixels of a worker's light-tracing film (0: no light tracing)."""
+        x0, y0, x1, y1 = self.scene.film.window
+        return (x1 - x0) * (y1 - y0) if self.light_tables is not None else 0
 
     def _update_stats(self, t_start):
         s = self.stats

@@ -121,8 +121,9 @@ def test_no_import_cycles():
 def test_integrator_vocabulary_is_declared_once():
     from mcengine.integrators import INTEGRATORS
     words = set(INTEGRATORS) | {info.enum_id for info in INTEGRATORS.values()}
-    # Also ordinary words: file paths, a metavar, Blender's "distribution" node property.
-    words -= {"path", "PATH", "distribution"}
+    # Also ordinary words: file paths, a metavar, Blender's "distribution" node property,
+    # the render passes' "light" readout and the scratch's last light sample.
+    words -= {"path", "PATH", "distribution", "light"}
     home = REPO / "mcengine" / "integrators.py"
     for name, path in MODULES.items():
         if path == home:

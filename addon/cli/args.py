@@ -390,6 +390,9 @@ def _add_study_parser(commands) -> None:
                                               f"(default {DEFAULT_TARGET_RELMSE:g})")
     study.add_argument("--reference-samples", type=_samples, default=None, metavar="M",
                        help="samples per pixel of each reference (default: 16 x N)")
+    study.add_argument("--reference", type=_integrator, default="path", metavar="NAME",
+                       help="integrator of MC Engine's reference: path (default), or light where "
+                            "path tracing misses caustics of point lamps")
     _add_integrator_options(study, for_study=True)
     study.add_argument("-S", "--scene", default=None,
                        help="scene to study (default: the file's active scene)")
@@ -705,6 +708,7 @@ class StudyRequest:
     resolution: tuple[int, int] | None
     target: float
     reference_samples: int | None
+    reference: str
     depth: int | None
     branching: int | None
     scene: str | None
@@ -728,8 +732,9 @@ def _study_request(args) -> StudyRequest:
         blendfile=blendfile, out=out, max_samples=args.max_samples,
         integrators=args.integrators, with_cycles=args.with_cycles, seeds=args.seeds,
         resolution=args.resolution, target=args.target,
-        reference_samples=args.reference_samples, depth=args.depth, branching=args.branching,
-        scene=args.scene, threads=args.threads, verbose=args.verbose, sampler=args.sampler)
+        reference_samples=args.reference_samples, reference=args.reference, depth=args.depth,
+        branching=args.branching, scene=args.scene, threads=args.threads, verbose=args.verbose,
+        sampler=args.sampler)
 
 
 def parse_args(argv: list[str]) -> RenderRequest | CompareRequest | StudyRequest | None:

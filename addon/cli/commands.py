@@ -444,7 +444,7 @@ def run_study(request: StudyRequest) -> int:
     options = StudyOptions(integrators=request.integrators, with_cycles=request.with_cycles,
                            max_samples=request.max_samples, seeds=request.seeds,
                            reference_samples=request.reference_samples,
-                           target_relmse=request.target)
+                           target_relmse=request.target, reference=request.reference)
     settings = StudySettings(resolution=request.resolution, depth=request.depth,
                              branching=request.branching, threads=request.threads,
                              sampler=request.sampler)

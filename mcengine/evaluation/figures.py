@@ -52,7 +52,7 @@ THUMBNAIL_GAP = 2
 # The study's plots: one colour and marker per engine, the integrators in the
 # registry's order, Cycles in grey.
 COLORS = {**{name: f"C{i}" for i, name in enumerate(NAMES)}, CYCLES: "C7"}
-MARKERS = {**dict(zip(NAMES, "os^D")), CYCLES: "v"}
+MARKERS = {**dict(zip(NAMES, "os^Dp")), CYCLES: "v"}
 STUDY_DPI = 110
 
 

@@ -303,9 +303,10 @@ def _same_errors(study: Study | None, a: str, b: str) -> bool:
 
 
 def _biased_by_design(name: str) -> bool:
-    """True for the lecture's classic integrators (every one but path tracing)."""
+    """True for the lecture's classic integrators (all but path tracing and path + light
+    tracing)."""
     info = INTEGRATORS.get(name)
-    return info is not None and not info.matches_cycles
+    return info is not None and not info.matches_cycles and not info.light_tracing
 
 
 def _leaves_out(name: str) -> str:

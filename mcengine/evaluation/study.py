@@ -192,9 +192,13 @@ class StudyOptions:
     reference_samples: int | None = None
     reference_renders: int = REFERENCE_RENDERS
     target_relmse: float = DEFAULT_TARGET_RELMSE
+    # The integrator whose converged render every MC Engine integrator is measured
+    # against: path tracing, or Path + Light Tracing where path tracing misses light
+    # (caustics of point lamps), so that its error shows as a plateau.
+    reference: str = REFERENCE_INTEGRATOR
 
     def validate(self) -> "StudyOptions":
-        for name in self.integrators:
+        for name in (*self.integrators, self.reference):
             try:
                 get_integrator(name)
             except ValueError as exc:
@@ -381,7 +385,7 @@ def run_study(render: Callable, options: StudyOptions, *, scene: str = "", setti
     options.validate()
     engines = options.engines()
     rungs = options.ladder()
-    ref_engines = ([REFERENCE_INTEGRATOR] if options.integrators else []) + (
+    ref_engines = ([options.reference] if options.integrators else []) + (
         [CYCLES] if options.with_cycles else [])
     warmups = [e for e in engines if e not in ref_engines]
     total = (len(ref_engines) * options.reference_renders + len(warmups)
@@ -401,7 +405,7 @@ def run_study(render: Callable, options: StudyOptions, *, scene: str = "", setti
         study.reference_previews[engine] = _preview(ref.image)
         study.height, study.width = ref.image.shape[:2]
     for engine in engines:
-        ref_name = CYCLES if engine == CYCLES else REFERENCE_INTEGRATOR
+        ref_name = CYCLES if engine == CYCLES else options.reference
         ref = study.references[ref_name]
         if engine in warmups:
             progress(f"{engine} warm-up")

@@ -32,6 +32,7 @@ from .lights import (
     L_SUN_OMC,
     L_TYPE,
     LF_CAST_SHADOW,
+    LF_LIGHT_TRACED,
     LF_USE_MIS,
     LF_VIS_CAMERA,
     LF_VIS_DIFFUSE,
@@ -44,7 +45,15 @@ from .lights import (
     sun_radiance,
 )
 from .sampling import power_heuristic, uniform_triangle
-from .state import PF_CAMERA, PF_DIFFUSE, PF_GLOSSY, PF_MIS_SKIP, PF_REFLECT, PF_TRANSMIT
+from .state import (
+    PF_CAMERA,
+    PF_CAUSTIC_EYE,
+    PF_DIFFUSE,
+    PF_GLOSSY,
+    PF_MIS_SKIP,
+    PF_REFLECT,
+    PF_TRANSMIT,
+)
 
 # How a light's selection probability is known, for MIS weights.
 PMF_GLOBAL = 0            # by power, scene-wide (lamps[:, L_PMF], emit_pmf)
@@ -119,7 +128,10 @@ def sample_triangle_point(verts, tris, tri, u1, u2):
 
 @device
 def lamp_visible_to_ray(flags, lamp_flags):
-    """Cycles' is_light_shader_visible_to_path for a ray of the given path flags."""
+    """Cycles' is_light_shader_visible_to_path for a ray of the given path flags; and not
+    to a singular bounce's ray on a path whose caustics light tracing renders."""
+    if (flags & PF_CAUSTIC_EYE) and (flags & PF_MIS_SKIP) and (lamp_flags & LF_LIGHT_TRACED):
+        return False
     if flags & PF_CAMERA:
         return (lamp_flags & LF_VIS_CAMERA) != 0
     if (lamp_flags & LF_USE_MIS) == 0:

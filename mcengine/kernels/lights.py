@@ -90,6 +90,7 @@ LF_VIS_CAMERA = 4
 LF_VIS_DIFFUSE = 8
 LF_VIS_GLOSSY = 16
 LF_VIS_TRANSMISSION = 32
+LF_LIGHT_TRACED = 64      # its caustic paths are light tracing's: path tracing's rays leave them
 
 
 def _unit(v):

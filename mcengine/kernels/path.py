@@ -79,6 +79,7 @@ from .shadows import trace_shadows
 from .state import (
     CFG_CAUSTICS,
     CFG_LAMPS_HIT,
+    CFG_LIGHT_TRACING,
     CFG_LIGHTS,
     CFG_LOCAL_LIGHTS,
     CFG_MAX_BOUNCE,
@@ -94,6 +95,8 @@ from .state import (
     FCFG_FILTER_GLOSSY,
     FCFG_WORLD_IMPORTANCE,
     MF_EMISSIVE,
+    PF_CAMERA,
+    PF_CAUSTIC_EYE,
     PF_DENOISE,
     PF_MIS_SKIP,
     PF_SURFACE_PASS,
@@ -126,6 +129,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
     mis = cfg[CFG_MIS] != 0
     caustics = cfg[CFG_CAUSTICS] != 0
+    light_tracing = cfg[CFG_LIGHT_TRACING] != 0
     nee = cfg[CFG_LIGHTS] != 0 and sc.light_cdf.shape[0] > 1
     local = cfg[CFG_LOCAL_LIGHTS] != 0
     pmf_mode = PMF_LOCAL if local else PMF_GLOBAL
@@ -285,8 +289,11 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         else:
             if split and bounce == 0:
                 _first_bounce_weights(pb, i, scratch.cl, ncl, -dx, -dy, -dz, ds)
-            st.flags[i] = count_bounce(st, i, cfg, next_path_flags(flags, ds.label) | PF_SURFACE_PASS,
-                                       ds.label)
+            new_flags = next_path_flags(flags, ds.label) | PF_SURFACE_PASS
+            if light_tracing and (flags & PF_CAMERA) and not (flags & PF_TRANSPARENT) \
+                    and not (ds.label & LABEL_SINGULAR):
+                new_flags |= PF_CAUSTIC_EYE     # x1 can be joined to the camera (light_tracing)
+            st.flags[i] = count_bounce(st, i, cfg, new_flags, ds.label)
             st.mis_pdf[i] = ds.pdf
             st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
             if ds.pdf > 0.0:

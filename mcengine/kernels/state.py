@@ -114,6 +114,8 @@ PF_DENOISE = 4096         # denoising albedo and normal not written yet
 PF_FIRST_SAMPLE = 8192    # the pixel's first sample (depth, position, indices come from it)
 PF_SINGULAR = 16384       # the ray was made by a singular (perfectly sharp) lobe
 PF_EMISSION = 32768       # shading a light sample's emission (Cycles' PATH_RAY_EMISSION)
+PF_CAUSTIC_EYE = 65536    # the camera ray's first surface scattered it through a lobe that is not
+                          # singular: its caustic paths may be light tracing's (``light_tracing``)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -141,7 +143,8 @@ CFG_CAUSTICS = 21         # caustic paths: Filter Glossy and the caustics switch
 CFG_SAMPLER = 22          # sampling.SAMPLER_*: which numbers paths draw
 CFG_SOBOL_MASK = 23       # mask of the Sobol sampler's shuffled sample index (sobol.index_mask)
 CFG_WORLD_SHADER = 24     # the background varies (textures, ray types): run the world's shader
-CFG_SIZE = 25
+CFG_LIGHT_TRACING = 25    # light tracing renders the caustics of the LF_LIGHT_TRACED lamps
+CFG_SIZE = 26
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1

@@ -66,6 +66,7 @@ class GradientSession:
         self.stats = SimpleNamespace(rays_per_second=2.5e6, eta_seconds=3.0,
                                      metadata=lambda seconds, samples: {"samples": str(samples)})
         self.plan = pack_scene(desc).plan
+        self.warnings = []          # what the integrator renders differently (none here)
         self.pass_images = []
 
     def run(self, on_pass=None, should_stop=None):

@@ -122,11 +122,14 @@ def test_light_passes_not_split_as_cycles_are_warned(scene, fake_session):
     assert not any("split of light" in w for w in fake_session[-1].desc.warnings)
 
 
-def test_classic_integrators_say_they_fill_combined_only(scene, fake_session):
+@pytest.mark.parametrize("integrator", ["whitted", "light"])
+def test_other_integrators_say_they_fill_combined_only(scene, fake_session, integrator):
+    """The classic integrators and Path + Light Tracing (whose caustics the light passes
+    could not hold) write Combined only, and say so."""
     layer = scene.view_layers[0]
     layer.use_pass_z = True
     scene.cycles.use_denoising = True
-    scene.mcengine.integrator = get_integrator("whitted").enum_id
+    scene.mcengine.integrator = get_integrator(integrator).enum_id
     bpy.ops.render.render()
     desc = fake_session[-1].desc
     assert desc.passes.names() == [] and desc.denoising.input_passes == "RGB"

@@ -57,8 +57,8 @@ def test_study_of_the_unsaved_scene_loads_its_plot(scene, tmp_path, capfd):
     assert _own_settings(scene) == before
     with open(tmp_path / "study.csv", newline="") as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == 4 * 3 * 2          # integrators x (1, 2, 4) x seeds
-    assert {r["integrator"] for r in rows} == {"path", "raycast", "whitted", "distribution"}
+    assert len(rows) == 5 * 3 * 2          # integrators x (1, 2, 4) x seeds
+    assert {r["integrator"] for r in rows} == {"path", "raycast", "whitted", "distribution", "light"}
     image = bpy.data.images["MC Engine Study"]
     assert bpy.path.abspath(image.filepath) == str(tmp_path / "error_vs_time.png")
     assert image.size[0] > 300 and image.size[1] > 200

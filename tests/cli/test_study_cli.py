@@ -73,11 +73,11 @@ def run_cli(*args) -> subprocess.CompletedProcess:
      "do not apply to --engine cycles"),
     (["render", "{cube}", "--sampler", "halton"], "unknown sampler 'halton'"),
     (["render", "{cube}", "--integrator", "whitted", "--sampler", "sobol"],
-     "--sampler applies to the path integrator only"),
+     "--sampler applies to the path and light integrators only"),
     (["render", "{cube}", "--engine", "cycles", "--sampler", "independent"],
      "do not apply to --engine cycles"),
     (["study", "{cube}", "--integrators", "raycast", "--sampler", "independent"],
-     "--sampler applies to the path integrator only"),
+     "--sampler applies to the path and light integrators only"),
 ])
 def test_bad_options_are_one_line_before_blender_starts(args, fragment, scenes, capsys):
     args = [a.format(cube=scenes / "cube.blend", missing=scenes / "missing.blend") for a in args]

@@ -60,7 +60,7 @@ from .layout import (
 from .microfacet import microfacet_eval, microfacet_sample
 from .sheen import sheen_eval, sheen_sample
 
-__all__ = ["bsdf_eval", "bsdf_sample", "closure_eval", "closure_sample", "LABEL_DIFFUSE",
+__all__ = ["bsdf_eval", "bsdf_sample", "bsdf_sample_closure", "closure_eval", "closure_sample", "LABEL_DIFFUSE",
            "LABEL_GLOSSY", "LABEL_NONE", "LABEL_REFLECT", "LABEL_SINGULAR", "LABEL_TRANSMIT",
            "LABEL_TRANSPARENT"]
 
@@ -170,19 +170,28 @@ def bsdf_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude):
     return fr, fg, fb, (sum_pdf / sum_sw if sum_sw > 0.0 else 0.0)
 
 
-@function
+@device
 def bsdf_sample(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
     """Sample the closure list: (wi world, weight r, g, b, pdf, label).
 
     The weight is the path throughput factor F / pdf; pdf is the mixture pdf
     (0 for a singular lobe, which other closures cannot produce).
     """
+    wix, wiy, wiz, r, g, b, pdf, label, _ = bsdf_sample_closure(cl, n, wox, woy, woz, u_pick,
+                                                                u1, u2, u3)
+    return wix, wiy, wiz, r, g, b, pdf, label
+
+
+@function
+def bsdf_sample_closure(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
+    """:func:`bsdf_sample`, and the row of the closure sampled (-1: none): light tracing
+    needs a singular lobe's normal and index of refraction."""
     total = 0.0
     for k in range(n):
         if cl[k, CL_TYPE] != CT_NONE:
             total += cl[k, CL_SW]
     if not total > 0.0:
-        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, -1
     target = u_pick * total
     acc = 0.0
     pick = -1
@@ -196,22 +205,22 @@ def bsdf_sample(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
                 break
             acc += sw
     if pick < 0:
-        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, -1
     sw = cl[pick, CL_SW]
     wix, wiy, wiz, r, g, b, pdf, label = closure_sample(cl, pick, wox, woy, woz, u1, u2, u3)
     if label == LABEL_NONE:
-        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, pick
     if label & (LABEL_SINGULAR | LABEL_TRANSPARENT):
         k = total / sw
         return (wix, wiy, wiz, cl[pick, CL_W] * r * k, cl[pick, CL_W + 1] * g * k,
-                cl[pick, CL_W + 2] * b * k, 0.0, label)
+                cl[pick, CL_W + 2] * b * k, 0.0, label, pick)
     if not pdf > 0.0:
-        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, pick
     fr, fg, fb, sum_pdf, sum_sw = _eval_sum(cl, n, pick, wox, woy, woz, wix, wiy, wiz, 0,
                                             cl[pick, CL_W] * r, cl[pick, CL_W + 1] * g,
                                             cl[pick, CL_W + 2] * b, pdf * sw, sw)
     # sum_sw now counts every closure once (the picked one was given as the start).
     mix_pdf = sum_pdf / sum_sw
     if not (mix_pdf > 0.0 and math.isfinite(mix_pdf)):
-        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-    return wix, wiy, wiz, fr / mix_pdf, fg / mix_pdf, fb / mix_pdf, mix_pdf, label
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, pick
+    return wix, wiy, wiz, fr / mix_pdf, fg / mix_pdf, fb / mix_pdf, mix_pdf, label, pick

@@ -134,6 +134,8 @@ def test_too_wide_a_ray_tree_is_a_clear_error():
 def test_kernel_codes_agree_with_the_registry():
     from mcengine.integrators import INTEGRATORS
     from mcengine.kernels import classic
+    # Path + Light Tracing runs the path tracer's kernels (code 0) and adds light paths.
     assert {name: info.kernel_code for name, info in INTEGRATORS.items()} == {
-        "path": 0, "raycast": classic.CODE_RAYCAST, "whitted": classic.CODE_WHITTED,
+        "path": 0, "light": 0, "raycast": classic.CODE_RAYCAST, "whitted": classic.CODE_WHITTED,
         "distribution": classic.CODE_DISTRIBUTION}
+    assert INTEGRATORS["light"].light_tracing and not INTEGRATORS["path"].light_tracing

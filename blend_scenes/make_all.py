@@ -42,6 +42,7 @@ SCENES = (
     "texture_procedural",
     "world_hdri_sun",
     "texture_image",
+    "texture_normal_map",
 )
 
 

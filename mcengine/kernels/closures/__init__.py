@@ -17,6 +17,10 @@ Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
   lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes)
   and the lobe's label.
 
+Every closure whose normal differs from the point's smooth normal (a normal map,
+Bump Map Correction's lift of a glossy normal) carries Cycles' bump shadowing
+term (``bump_shadowing``), in ``closure_eval`` and ``closure_sample``.
+
 Directions passed here are in world space: ``wo`` towards the viewer, ``wi``
 towards the light or the sampled direction.
 """
@@ -35,7 +39,9 @@ from .diffuse import (
     translucent_sample,
 )
 from .layout import (
+    CL_BUMP_CORRECTION,
     CL_N,
+    CL_NS,
     CL_SW,
     CL_T,
     CL_TYPE,
@@ -57,7 +63,7 @@ from .layout import (
     LABEL_TRANSMIT,
     LABEL_TRANSPARENT,
 )
-from .microfacet import microfacet_eval, microfacet_sample
+from .microfacet import ggx_lambda_q, microfacet_eval, microfacet_sample
 from .sheen import sheen_eval, sheen_sample
 
 __all__ = ["bsdf_eval", "bsdf_sample", "bsdf_sample_closure", "closure_eval", "closure_sample", "LABEL_DIFFUSE",
@@ -77,24 +83,69 @@ def frame(cl, k):
     return tx, ty, tz, bx, by, bz, nx, ny, nz
 
 
+@device
+def is_diffuse(t):
+    """Whether closures of type t are diffuse-like (Cycles' CLOSURE_IS_BSDF_DIFFUSE: sheen and
+    translucent included)."""
+    return t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT
+
+
+@device
+def bump_shadowing(cl, k, diffuse, is_eval, wix, wiy, wiz):
+    """Cycles' bump_shadowing_term: the factor on closure k's value towards wi when its normal
+    N differs from the point's smooth normal Ns.
+
+    0 when wi lies on the other side of Ns than N says (light leaking through the surface;
+    on evaluation for every closure, on sampling for diffuse ones); diffuse closures of a
+    material with Bump Map Correction are then darkened towards grazing wi by a GGX
+    shadowing G1(alpha², |Ns·wi|) with alpha² = min(tan²(N, Ns) / 8, 1) (Conty et al.,
+    "A Microfacet-Based Shadowing Function to Solve the Bump Terminator Problem").  The pdf
+    is left alone, as in Cycles.
+    """
+    nx, ny, nz = cl[k, CL_N], cl[k, CL_N + 1], cl[k, CL_N + 2]
+    sx, sy, sz = cl[k, CL_NS], cl[k, CL_NS + 1], cl[k, CL_NS + 2]
+    if nx == sx and ny == sy and nz == sz:
+        return 1.0
+    cos_si = sx * wix + sy * wiy + sz * wiz
+    cos_sn = sx * nx + sy * ny + sz * nz
+    cos_ni = nx * wix + ny * wiy + nz * wiz
+    if cos_si * cos_sn * cos_ni < 0.0 and (is_eval or diffuse):
+        return 0.0
+    if not diffuse or cl[k, CL_BUMP_CORRECTION] == 0.0:
+        return 1.0
+    cos_i, cos_d = abs(cos_si), abs(cos_sn)
+    if cos_d >= 1.0 or cos_i >= 1.0:
+        return 1.0
+    if cos_i < 1e-6:
+        return 0.0
+    alpha2 = min(max(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0), 1.0)
+    return 1.0 / (1.0 + ggx_lambda_q(alpha2 * max(1.0 / (cos_i * cos_i) - 1.0, 0.0)))
+
+
 @function
 def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
-    """(r, g, b, pdf) of closure k for world directions, without its weight."""
+    """(r, g, b, pdf) of closure k for world directions, without its weight (times the bump
+    shadowing term; a direction it rejects has pdf 0)."""
     t = cl[k, CL_TYPE]
+    shadowing = bump_shadowing(cl, k, is_diffuse(t), True, wix, wiy, wiz)
+    if shadowing == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
     tx, ty, tz, bx, by, bz, nx, ny, nz = frame(cl, k)
     lox, loy, loz = wox * tx + woy * ty + woz * tz, wox * bx + woy * by + woz * bz, wox * nx + woy * ny + woz * nz
     lix, liy, liz = wix * tx + wiy * ty + wiz * tz, wix * bx + wiy * by + wiz * bz, wix * nx + wiy * ny + wiz * nz
     if t == CT_DIFFUSE:
-        return lambert_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    if t == CT_OREN_NAYAR:
-        return oren_nayar_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    if t == CT_TRANSLUCENT:
-        return translucent_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    if t == CT_SHEEN:
-        return sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
-        return microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    return 0.0, 0.0, 0.0, 0.0
+        r, g, b, pdf = lambert_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_OREN_NAYAR:
+        r, g, b, pdf = oren_nayar_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_TRANSLUCENT:
+        r, g, b, pdf = translucent_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_SHEEN:
+        r, g, b, pdf = sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+        r, g, b, pdf = microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    else:
+        return 0.0, 0.0, 0.0, 0.0
+    return r * shadowing, g * shadowing, b * shadowing, pdf
 
 
 @function
@@ -118,8 +169,11 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
         return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
     else:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
-    return (x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz,
-            r, g, b, pdf, label)
+    wix, wiy, wiz = x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz
+    if not (label & LABEL_TRANSMIT):     # Cycles leaves transmitted samples without the term
+        shadowing = bump_shadowing(cl, k, is_diffuse(t), False, wix, wiy, wiz)
+        r, g, b = r * shadowing, g * shadowing, b * shadowing
+    return wix, wiy, wiz, r, g, b, pdf, label
 
 
 @device
@@ -128,7 +182,7 @@ def excluded(t, exclude):
     closures of type t from it (Cycles' _surface_shader_exclude)."""
     if exclude == 0:
         return False
-    if t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT:
+    if is_diffuse(t):
         return (exclude & LABEL_DIFFUSE) != 0
     if t == CT_MICROFACET:
         return (exclude & LABEL_GLOSSY) != 0

@@ -46,7 +46,9 @@ CL_P2 = 32
 CL_P3 = 33
 CL_P4 = 34
 CL_ALBEDO = 36           # 3: microfacet: the albedo estimate at the view, from the setup (layering)
-CL_STRIDE = 39
+CL_NS = 39               # 3: the point's smooth (interpolated, not normal-mapped) normal, viewer's side
+CL_BUMP_CORRECTION = 42  # 1: the material's Bump Map Correction is on (softens diffuse closures)
+CL_STRIDE = 43
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0

@@ -26,6 +26,7 @@ from ..closures.layout import (
     CL_ALBEDO,
     CL_AX,
     CL_AY,
+    CL_BUMP_CORRECTION,
     CL_DIST,
     CL_ENERGY,
     CL_ETA,
@@ -34,6 +35,7 @@ from ..closures.layout import (
     CL_F90,
     CL_FRESNEL,
     CL_N,
+    CL_NS,
     CL_RTINT,
     CL_STRIDE,
     CL_SW,
@@ -146,6 +148,9 @@ def alloc(cl, n, wr, wg, wb, sd):
     cl[n, CL_W], cl[n, CL_W + 1], cl[n, CL_W + 2] = wr, wg, wb
     cl[n, CL_SW] = sw
     cl[n, CL_ENERGY] = 1.0
+    # What the bump shadowing term (closures.bump_shadowing) compares the closure's normal with.
+    cl[n, CL_NS], cl[n, CL_NS + 1], cl[n, CL_NS + 2] = sd.nx, sd.ny, sd.nz
+    cl[n, CL_BUMP_CORRECTION] = 1.0 if sd.bump_correction else 0.0
     return n, n + 1
 
 

@@ -72,6 +72,22 @@ def test_depth_of_field_errors_are_caught(renders, what, edit):
     assert result.agreement.differing_blocks()
 
 
+def _without_bump_map_correction(scene):
+    for material in bpy.data.materials:
+        material.cycles.use_bump_map_correction = False
+
+
+def test_missing_bump_shadowing_is_caught(renders):
+    """Without Bump Map Correction MC Engine leaves out the bump shadowing term's darkening
+    of diffuse closures towards grazing light, which Cycles applies to the original: the
+    normal-mapped floor under the low sun is too bright."""
+    result = renders.compare("texture_normal_map", "no bump map correction",
+                             _without_bump_map_correction)
+    a = result.agreement
+    assert result.verdict == "differ"
+    assert np.all(a.frame_rejected) and np.all(a.frame_rel_bias > 0)
+
+
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
 def test_cycles_agrees_with_itself_across_seeds(blend, renders):
     name = blend.stem

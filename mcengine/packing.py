@@ -140,7 +140,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         tex=TextureData(attr=attr, normals=normals,
                         tri_object=np.ascontiguousarray(g.object_index, np.int32),
                         objects=pack_objects(g), camera=camera, images=images.info,
-                        pix8=images.pix8, pixf=images.pixf),
+                        pix8=images.pix8, pixf=images.pixf, verts=verts, tris=tris),
         bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)))
 
     # The world as a light: its importance map, when its radiance varies.

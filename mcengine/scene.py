@@ -252,6 +252,9 @@ class Material:
     ``use_transparent_shadow`` lets shadow rays through transparent closures;
     ``use_bump_map_correction`` tilts glossy normals whose mirror direction
     would point into the surface (Cycles' material setting of that name).
+    ``displacement`` is what the output's Displacement socket receives: with
+    ``displacement_method`` 'BUMP' (or 'BOTH', whose true displacement is not rendered)
+    it bumps the shading normal as Cycles' automatic bump does (``shaders``).
 
     A material without ``nodes`` is described by the shorthand fields, a sum of
     closures convenient for tests and tools, equivalent to the graph
@@ -265,6 +268,8 @@ class Material:
     name: str = "default"
     nodes: list = field(default_factory=list)
     surface: Link | None = None
+    displacement: Link | None = None
+    displacement_method: str = "BUMP"
     use_transparent_shadow: bool = True
     use_bump_map_correction: bool = True
     pass_index: int = 0
@@ -825,7 +830,8 @@ def _check_image(name, im) -> None:
 def _check_graph(where: str, material: Material) -> None:
     """Links point at existing nodes and every constant input is finite."""
     nodes = material.nodes
-    links = [material.surface] if material.surface is not None else []
+    links = [link for link in (material.surface, getattr(material, "displacement", None))
+             if link is not None]
     for k, node in enumerate(nodes):
         if not isinstance(node, ShaderNode) or not isinstance(node.type, str):
             raise SceneError(f"{where}: node {k} is not a ShaderNode")

@@ -17,6 +17,15 @@ does (scene/shader_graph.cpp, svm.cpp), and emits a straight-line program for
   is evaluated here, ahead of time, and becomes constants (constant folding);
   a texture's unlinked Vector input gets the coordinate Cycles uses (a
   Texture Coordinate node's Generated or UV output);
+* a Bump node's Height sub-graph is emitted three times, as Cycles does
+  (shader_graph.cpp refine_bump_nodes): at the point, and between ``OP_BUMP``
+  rows that move the point along dPdx, then dPdy, by the node's Filter Width
+  (a fresh copy of every node on the way, texture coordinates included); the
+  material output's Displacement (method 'BUMP', or 'BOTH' without its true
+  displacement) becomes Cycles' automatic bump (bump_from_displacement): its
+  vector dotted with the normal is the height of a Bump node of Distance 1
+  whose normal replaces the shading normal (``BUMP_SET_NORMAL``) before the
+  surface's nodes run;
 * a closure node builds its closures (``OP_CLOSURE``); a Mix Shader computes
   the weights of its two inputs from its factor (``OP_MIX_WEIGHT``: in x
   (1 - fac) and in x fac), an Add Shader passes its weight to both; a closure
@@ -40,12 +49,17 @@ from .kernels.camera import CAMERA_PARAMS
 from .kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
 from .kernels.state import MF_BUMP_CORRECTION, MF_EMISSION_VARIES, MF_EMISSIVE, MF_TRANSPARENT
 from .kernels.svm import (
+    BUMP_DX,
+    BUMP_DY,
+    BUMP_LEAVE,
+    BUMP_SET_NORMAL,
     CONV_COLOR_TO_FLOAT,
     CONV_FLOAT_TO_VECTOR,
     CONV_VECTOR_TO_FLOAT,
     IMG_STRIDE,
     MAX_REGS,
     OBJ_STRIDE,
+    OP_BUMP,
     OP_CLOSURE,
     OP_CONVERT,
     OP_COPY,
@@ -58,6 +72,7 @@ from .kernels.svm import (
     eval_shader,
 )
 from .kernels.svm.nodes import (
+    BUMP_HEIGHTS,
     CLOSURES,
     COLOR,
     ENUMS,
@@ -80,6 +95,9 @@ __all__ = ["AttributeLayout", "DEFAULT_COLOR_ATTRIBUTE", "Program", "compile_mat
 # The name under which a mesh's default colour attribute (Blender's render colour) is also
 # stored: what a Color Attribute node with no name reads, as Cycles' ATTR_STD_VERTEX_COLOR.
 DEFAULT_COLOR_ATTRIBUTE = ".default color"
+# Displacement methods whose displacement Cycles turns into a bump ('BOTH' also displaces
+# the mesh, which is not rendered: warned at export).
+BUMP_METHODS = ("BUMP", "BOTH")
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
 # Inputs whose constant values decide whether a closure node can emit or let light through.
 _EMISSION_INPUTS = {"Emission": ("Color", "Strength"),
@@ -167,8 +185,51 @@ class _Compiler:
 
     def compile(self) -> Program:
         if self.surface is not None:
+            displacement = getattr(self.material, "displacement", None)
+            if displacement is not None and self.material.displacement_method in BUMP_METHODS:
+                self.displacement_bump(displacement)
             self.shader(self.surface, NO_WEIGHT, False)
         return self.program
+
+    def displacement_bump(self, link: Link) -> None:
+        """Cycles' automatic bump from the output's Displacement: a Bump node (Distance 1,
+        Strength 1, the node's default filter width; in object space for method 'BOTH')
+        whose Height is the displacement dotted with the Geometry node's Normal; its normal
+        becomes the shading normal for the rest of the program."""
+        k = len(self.nodes)
+        self.nodes = self.nodes + [
+            ShaderNode("NewGeometry"),
+            ShaderNode("VectorMath", {"Vector": link, "Vector_001": Link(k, "Normal")},
+                       {"operation": "DOT_PRODUCT"}),
+            ShaderNode("Bump", {"Height": Link(k + 1, "Value"), "Distance": 1.0, "Strength": 1.0},
+                       {"use_object_space": float(self.material.displacement_method == "BOTH")})]
+        normal = self.output(Link(k + 2, "Normal"))
+        reg = normal.reg if not normal.constant else self.program.store(normal.const)
+        self.program.ops.append([OP_BUMP, BUMP_SET_NORMAL, reg, 0])
+        # Nodes after this see the bumped normal: the surface compiles its own copies.
+        self.outputs, self.implicit = {}, {}
+
+    def bump_heights(self, node, spec, values) -> list:
+        """A Bump node's inputs with its Height at the two offset points: the Height sub-graph
+        again, fresh, between OP_BUMP rows (Filter Width: its unlinked value, as Cycles)."""
+        names = [s.name for s in spec.inputs]
+        k = names.index("Filter Width")
+        width = values[k].const[0] if values[k].constant else spec.inputs[k].default
+        values[k] = Value(FLOAT, (float(width),))
+        centre, dx, dy = (names.index(h) for h in BUMP_HEIGHTS)
+        height = node.inputs.get("Height")
+        if not isinstance(height, Link) or values[centre].constant:
+            values[dx] = values[dy] = values[centre]
+            return values
+        width_reg = self.program.store((width,))
+        for axis, i in ((BUMP_DX, dx), (BUMP_DY, dy)):
+            self.program.ops.append([OP_BUMP, axis, width_reg, 0])
+            saved = self.outputs, self.implicit
+            self.outputs, self.implicit = {}, {}
+            values[i] = self.converted(self.output(height), FLOAT)
+            self.outputs, self.implicit = saved
+            self.program.ops.append([OP_BUMP, BUMP_LEAVE, 0, 0])
+        return values
 
     def error(self, message: str) -> SceneError:
         return SceneError(f"material '{self.material.name}': {message}")
@@ -289,7 +350,9 @@ class _Compiler:
     def evaluate(self, node, spec) -> dict:
         """Compile value node ``node`` (or fold it); its outputs by name."""
         values = [self.input(node, socket) for socket in spec.inputs]
-        if node.type in _ATTRIBUTE_READERS:
+        if node.type == "Bump":
+            values = self.bump_heights(node, spec, values)
+        elif node.type in _ATTRIBUTE_READERS:
             values = self.attribute_inputs(node, spec, values)
         elif node.type in IMAGE_NODES:
             values = self.image_inputs(node, spec, values)
@@ -386,12 +449,13 @@ _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map
 
 # What the compiler shows a node it evaluates ahead of time: no point, no scene.
 _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
-                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0)
+                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0.0)
 _NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
                            tri_object=np.zeros(0, np.int32),
                            objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
                            images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
-                           pixf=np.zeros(0, np.float32))
+                           pixf=np.zeros(0, np.float32), verts=np.zeros((0, 3)),
+                           tris=np.zeros((0, 3), np.int32))
 
 
 class ShaderTable:

@@ -87,19 +87,38 @@ def convert_material(ctx, material) -> Material:
         return Material(name=name, base_color=BLACK, **settings)
     graph = _MaterialGraph(ctx)
     graph.pass_index = float(getattr(material, "pass_index", 0))
-    for socket_name, what in (("Volume", "volume"), ("Displacement", "displacement")):
-        src = linked_node(out.inputs[socket_name])
-        if src is not None:
-            graph.note(f"{what} ({label(src)})", what)
+    src = linked_node(out.inputs["Volume"])
+    if src is not None:
+        graph.note(f"volume ({label(src)})", "volume")
     surface = graph.shader(out.inputs["Surface"])
+    displacement = _displacement(graph, material, out)
     if surface is None:
         result = Material(name=name, base_color=BLACK, **settings)
     else:
-        result = Material(name=name, nodes=graph.nodes, surface=surface, **settings)
+        result = Material(name=name, nodes=graph.nodes, surface=surface, displacement=displacement,
+                          displacement_method=str(material.displacement_method), **settings)
     if graph.items:
         ctx.warn(f"material '{name}': {', '.join(graph.items)} not supported yet; "
                  f"{'; '.join(graph.fallbacks) or 'ignored'}", *graph.features)
     return result
+
+
+def _displacement(graph, material, out):
+    """What the output's Displacement receives (a Link, else None), rendered as Cycles' bump
+    from displacement; true displacement (methods 'DISPLACEMENT' and 'BOTH') is warned."""
+    socket = out.inputs["Displacement"]
+    src = linked_node(socket)
+    if src is None:
+        return None
+    method = str(getattr(material, "displacement_method", "BUMP"))
+    if method == "DISPLACEMENT":
+        graph.note(f"true displacement ({label(src)})", "displacement", "the surface is not displaced")
+        return None
+    if method == "BOTH":
+        graph.note(f"true displacement ({label(src)})", "displacement",
+                   "the surface is not displaced, only bumped (Displacement and Bump)")
+    link = graph.input(out, socket, Socket("Displacement", "vector", None), ())
+    return link if isinstance(link, Link) else None
 
 
 class _MaterialGraph(GraphReader):

@@ -173,6 +173,32 @@ def camera_ray(cam, rx, ry, lens_u, lens_v):
 
 
 @device
+def camera_differential(cam, rx, ry):
+    """Cycles' compact ray differential of the camera ray through raster position (rx, ry):
+    (footprint at the ray's origin, its growth per unit of ray length).
+
+    Perspective (with or without depth of field, as Cycles): the mean change of the unit
+    direction over one pixel step in x and in y, the footprint at the near plane that growth
+    times the distance to it.  Orthographic: the width of a pixel, not growing (Cycles takes
+    the x step for both axes).
+    """
+    sx = 2.0 * cam[C_HALF_W] / cam[C_WIDTH]
+    if cam[C_TYPE] == CAM_ORTHO:
+        return sx, 0.0
+    sy = 2.0 * cam[C_HALF_H] / cam[C_HEIGHT]
+    x = cam[C_SHIFT_X] + (2.0 * rx / cam[C_WIDTH] - 1.0) * cam[C_HALF_W]
+    y = cam[C_SHIFT_Y] + (1.0 - 2.0 * ry / cam[C_HEIGHT]) * cam[C_HALF_H]
+    r = math.sqrt(x * x + y * y + 1.0)
+    # Raster y grows downwards: one pixel step lowers y (the sign does not change a length).
+    rxx = math.sqrt((x + sx) * (x + sx) + y * y + 1.0)
+    ryy = math.sqrt(x * x + (y - sy) * (y - sy) + 1.0)
+    ddx = math.sqrt(((x + sx) / rxx - x / r) ** 2 + (y / rxx - y / r) ** 2 + (1.0 / rxx - 1.0 / r) ** 2)
+    ddy = math.sqrt((x / ryy - x / r) ** 2 + ((y - sy) / ryy - y / r) ** 2 + (1.0 / ryy - 1.0 / r) ** 2)
+    dd = 0.5 * (ddx + ddy)
+    return cam[C_CLIP_START] * r * dd, dd
+
+
+@device
 def aperture_point(cam, u1, u2):
     """Point on the lens in camera coordinates (x right, y up), Cycles' camera_sample_aperture.
 
@@ -274,6 +300,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.mis_p[n, 0], st.mis_p[n, 1], st.mis_p[n, 2] = ox, oy, oz   # ray length from here
             st.min_pdf[n] = math.inf
             st.self_prim[n] = -1
+            st.dp[n], st.dd[n] = camera_differential(sc.camera, x + fx, y + fy)
             st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz
             st.d32[n, 0], st.d32[n, 1], st.d32[n, 2] = dx, dy, dz
             st.t32[n] = min(tmax, T_INFINITE)

@@ -132,6 +132,8 @@ def _copy_node(nx, n_next, st, i, advance):
     for c in range(3):
         nx.mis_p[n_next, c] = st.mis_p[i, c]
     nx.self_prim[n_next] = st.self_prim[i]
+    nx.dp[n_next] = st.dp[i] + st.dd[i] * advance
+    nx.dd[n_next] = st.dd[i]
     dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
     set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
             st.ray_o[i, 0] + advance * dx, st.ray_o[i, 1] + advance * dy,
@@ -190,8 +192,10 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
             continue   # a terminated path only collects emission, and there is none
         depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
+        # Ray differentials on camera rays only (Bump nodes leave later levels' normals alone).
+        footprint = st.dp[i] + st.dd[i] * t_hit if bounce == 0 else 0.0
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
-                          depths)
+                          depths, footprint)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,
                                flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,

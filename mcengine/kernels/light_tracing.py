@@ -226,7 +226,7 @@ def _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t, flags):
     """Triangle p's closures at (b1, b2) for a viewer at -d (to ``scratch.cl``)."""
     sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
     res = shade_point(sc, cfg, scratch, sp, sc.mat_index[p], p, b1, b2, dx, dy, dz, t, flags, True,
-                      (0, 0, 0, 0, 0))
+                      (0, 0, 0, 0, 0), 0.0)
     return sp, res
 
 

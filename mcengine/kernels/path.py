@@ -201,8 +201,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
         ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
         depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
+        footprint = st.dp[i] + st.dd[i] * ray_length     # Cycles' differential_transfer_compact
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
-                          not terminate, depths)
+                          not terminate, depths, footprint)
 
         # Holdout: the film's alpha drops by the holdout weight on camera paths.
         if res.holdout > 0.0 and (flags & PF_TRANSPARENT_BG):
@@ -296,6 +297,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             st.flags[i] = count_bounce(st, i, cfg, new_flags, ds.label)
             st.mis_pdf[i] = ds.pdf
             st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
+            st.dp[i] = footprint     # Cycles keeps the camera's dD at every bounce
             if ds.pdf > 0.0:
                 st.min_pdf[i] = min(st.min_pdf[i], ds.pdf)
         nox, noy, noz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz,

@@ -269,7 +269,7 @@ def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
 
 @device
 def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b1, b2, obj, flags,
-                 ray_length, depths):
+                 ray_length, depths, dp):
     """The ``ShadingData`` of surface point ``sp`` for a ray of direction d, every field of
     one fixed type (float64, bool, int64; numba's int() would keep an int32 an int32),
     whatever its callers pass: the shader evaluator and every node function it calls are then
@@ -280,15 +280,17 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
                        -dx, -dy, -dz, bool(sp.backfacing), bool(allocate), bool(reflective),
                        bool(refractive), bool(bump), i64(prim), float(b1), float(b2), i64(obj),
                        i64(flags), float(ray_length), i64(depths[0]), i64(depths[1]),
-                       i64(depths[2]), i64(depths[3]), i64(depths[4]))
+                       i64(depths[2]), i64(depths[3]), i64(depths[4]), float(dp))
 
 
 @device
-def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths):
+def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths,
+                footprint):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
     direction d and length t_hit (from the vertex it left, through transparent surfaces, as
     Cycles measures it), on a path with ``flags`` and ``depths`` (bounces: all, diffuse,
-    glossy, transmission, transparent).
+    glossy, transmission, transparent) and the ray differential's ``footprint`` there (0: none,
+    the Bump node then leaves the normal unchanged).
 
     The closures go to ``scratch.cl``; returns the ``ShaderResult``.  With
     ``allocate`` false only emission, transparency and holdout are computed.
@@ -298,7 +300,7 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
                       cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
                       cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
                       (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
-                      p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths)
+                      p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths, footprint)
     return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
                        sd, sc.tex)
 
@@ -313,7 +315,7 @@ def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths):
     m = sc.mat_index[tri]
     sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, tri, b1, b2, dx, dy, dz)
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
-                      sc.tex.tri_object[tri], PF_EMISSION, dist, depths)
+                      sc.tex.tri_object[tri], PF_EMISSION, dist, depths, 0.0)
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                       scratch.cl_light, sd, sc.tex)
     return res.er, res.eg, res.eb

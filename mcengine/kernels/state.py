@@ -35,6 +35,8 @@ PathState = namedtuple("PathState", [
     "min_pdf",       # (B,) f64      smallest BSDF pdf on the path so far (Filter Glossy)
     "mis_p",         # (B, 3) f64    the vertex that ray left (light picking there, for MIS)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
+    "dp",            # (B,) f64      ray differential: footprint at mis_p (Cycles' compact ray dP)
+    "dd",            # (B,) f64      its growth per unit length (the camera's compact dD)
     "alive",         # (B,) uint8    still tracing after this bounce
     "o32",           # (B, 3) f32    Embree input: origins
     "d32",           # (B, 3) f32    Embree input: directions
@@ -174,7 +176,7 @@ def alloc_path_state(n: int) -> PathState:
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
         mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
-        alive=np.zeros(n, np.uint8),
+        dp=np.zeros(n), dd=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
 

@@ -18,6 +18,11 @@ and writes its closures at this point into the closure list ``cl`` (see
                    c = first of two registers: in x (1 - fac), in x fac
 ``OP_CLOSURE``     a = node kind (``nodes.K_*``), b = its first input register,
                    c = weight register (-1: 1): build the node's closures
+``OP_BUMP``        a = ``BUMP_*``: the rows up to the next BUMP_LEAVE see the point moved
+                   along dPdx (BUMP_DX) or dPdy (BUMP_DY) by the filter width in register b
+                   (a Bump node's Height sub-graph, ``bump.bump_point``), BUMP_LEAVE restores
+                   it; BUMP_SET_NORMAL: the shading normal becomes the vector in register b
+                   for the rest of the program (displacement as bump)
 
 The result is the number of closures, the emitted radiance, the transparency
 (the summed weight of transparent closures, which shadow rays pass through)
@@ -31,6 +36,7 @@ from collections import namedtuple
 import numpy as np
 
 from ...jit import device, function
+from .bump import bump_point, with_normal
 from .closure_nodes import eval_closure_node
 from .color_nodes import eval_color_node
 from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
@@ -70,6 +76,11 @@ OP_MIX_WEIGHT = 2
 OP_CLOSURE = 3
 OP_COPY = 4
 OP_CONVERT = 5
+OP_BUMP = 6
+BUMP_LEAVE = 0                # OP_BUMP a
+BUMP_DX = 1
+BUMP_DY = 2
+BUMP_SET_NORMAL = 3
 MAX_REGS = 1 << 22            # registers of all materials together (32 MiB per worker)
 
 # Implicit conversions of a link (OP_CONVERT c).
@@ -127,6 +138,7 @@ def eval_shader(ops, start, end, regs, cl, sd, tex):
     er = eg = eb = 0.0
     tr = tg = tb = 0.0
     holdout = 0.0
+    point = sd               # the unmoved point (OP_BUMP)
     for pc in range(start, end):
         op = ops[pc, 0]
         a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
@@ -150,6 +162,14 @@ def eval_shader(ops, start, end, regs, cl, sd, tex):
                 regs[a + k] = regs[b + k]
         elif op == OP_CONVERT:
             convert(regs, a, b, c)
+        elif op == OP_BUMP:
+            if a == BUMP_LEAVE:
+                sd = point
+            elif a == BUMP_SET_NORMAL:
+                point = with_normal(point, regs[b], regs[b + 1], regs[b + 2])
+                sd = point
+            else:
+                sd = bump_point(point, tex, regs[b], a)
         elif op == OP_MIX_WEIGHT:
             fac = min(max(regs[a], 0.0), 1.0)
             w = regs[b] if b >= 0 else 1.0

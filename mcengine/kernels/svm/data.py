@@ -26,6 +26,8 @@ ShadingData = namedtuple("ShadingData", [
     "ray_length",              # length of the ray that arrived here
     "depth",                   # bounces so far, and per kind (Light Path node)
     "diffuse_depth", "glossy_depth", "transmission_depth", "transparent_depth",
+    "dp",                      # the ray differential's footprint here (Cycles' compact sd->dP:
+                               # dPdx, dPdy are dp times two unit tangents; 0: no differential)
 ])
 
 TextureData = namedtuple("TextureData", [
@@ -37,6 +39,8 @@ TextureData = namedtuple("TextureData", [
     "images",                  # (I, IMG_STRIDE) int64  the render's images (IMG_* columns)
     "pix8",                    # (N,) uint8    texels of the 8-bit images, row after row
     "pixf",                    # (N,) float32  texels of the float images
+    "verts",                   # (V, 3) f64     the triangles (world space): the Bump node's
+    "tris",                    # (T, 3) int32   offset points on them (svm.bump_point)
 ])
 
 # Per-object data (TextureData.objects columns).

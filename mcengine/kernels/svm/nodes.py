@@ -451,7 +451,16 @@ VALUE_NODES = {
     #    TANGENT_PREFIX; its 4 components are the MikkTSpace tangent and sign, object space)
     "NormalMap": NodeSpec(601, (_f("Strength", 1.0), _c("Color", (0.5, 0.5, 1.0)), _p("space", SPACE_TANGENT),
                                 _p("attribute", -1)), (_v("Normal", UNLINKED),), False),
+    # Bump: "Height" is the height at the point, "Height_dx" and "Height_dy" the compiler's
+    # copies of its sub-graph at the offset points (BUMP_HEIGHTS; svm/bump.py)
+    "Bump": NodeSpec(602, (_f("Strength", 1.0), _f("Distance", 0.001), _f("Filter Width", 0.1),
+                           _f("Height", 1.0), _f("Height_dx", 1.0), _f("Height_dy", 1.0), _v("Normal"),
+                           _p("invert", 0), _p("use_object_space", 0)), (_v("Normal", UNLINKED),), False),
+    "Displacement": NodeSpec(603, (_f("Height", 0.0), _f("Midlevel", 0.5), _f("Scale", 0.01), _v("Normal"),
+                                   _p("space", SPACE_OBJECT)), (_v("Displacement", UNLINKED),), False),
 }
+# The Bump node's three heights: at the point, at the point moved along dPdx and along dPdy.
+BUMP_HEIGHTS = ("Height", "Height_dx", "Height_dy")
 IMAGE_NODES = ("TexImage", "TexEnvironment")     # nodes that read an image (``prop:image``)
 
 # Name of the per-corner tangent attribute of a UV map ("" is the default UV map).

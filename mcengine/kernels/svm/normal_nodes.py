@@ -1,4 +1,5 @@
-"""Normal nodes: a perturbed shading normal for the closures (kernel/svm/tex_coord.h).
+"""Normal nodes: a perturbed shading normal for the closures (kernel/svm/tex_coord.h);
+Bump is in ``bump.py``.
 
 Normal Map works as Cycles does, in object space: the MikkTSpace tangent and
 sign of the UV map (per-corner attribute ``tangent:<uv map>``, object space, as
@@ -13,6 +14,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from .bump import bump_normal, displacement
 from .input_nodes import attribute, normal_to_object, normal_to_world
 from .math_nodes import safe_normalize
 from .nodes import (
@@ -29,12 +31,20 @@ _NM_STRENGTH = OFFSETS["NormalMap"]["Strength"]
 _NM_COLOR = OFFSETS["NormalMap"]["Color"]
 _NM_SPACE = OFFSETS["NormalMap"]["prop:space"]
 _NM_TANGENT = OFFSETS["NormalMap"]["prop:attribute"]
+_BUMP = NODES["Bump"].code
+_DISPLACEMENT = NODES["Displacement"].code
 
 
 @function
 def eval_normal_node(code, regs, b, c, sd, tex):
     if code == _NORMAL_MAP:
         x, y, z = normal_map(regs, b, sd, tex)
+        regs[c], regs[c + 1], regs[c + 2] = x, y, z
+    elif code == _BUMP:
+        x, y, z = bump_normal(regs, b, sd, tex)
+        regs[c], regs[c + 1], regs[c + 2] = x, y, z
+    elif code == _DISPLACEMENT:
+        x, y, z = displacement(regs, b, sd, tex)
         regs[c], regs[c + 1], regs[c + 2] = x, y, z
 
 

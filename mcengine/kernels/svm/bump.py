@@ -1,0 +1,161 @@
+"""Bump: Cycles' finite-difference bump (kernel/svm/displace.h, bump.h, util/differential.h).
+
+The compiler emits a Bump node's Height sub-graph three times: at the point, and at the
+point moved by Filter Width times the ray differential's dPdx, then dPdy
+(``OP_BUMP``: ``bump_point`` is the moved point; every texture coordinate follows from it,
+as Cycles shifts P and each attribute by its x or y derivative).  The differentials
+are Cycles' compact ones: a footprint ``sd.dp`` (ray_dP + t ray_dD) times the two unit
+tangents ``make_orthonormals`` builds about the geometric normal.  The node then
+combines the three heights as ``svm_node_set_bump`` does:
+
+    R_x = dPdy x N, R_y = N x dPdx, det = dPdx . R_x,
+    N' = normalize(w |det| N - d sign(det) ((h_x - h_c) R_x + (h_y - h_c) R_y)),
+    out = normalize(s N' + (1 - s) N)
+
+with N the Normal input (unlinked: the shading normal), d the Distance (negated by
+Invert), w the filter width and s = max(Strength, 0); in object space (displacement
+as bump with method 'BOTH') N and the differentials are taken to object space first.
+
+The Displacement node (``svm_node_displacement``) gives N (h - midlevel) scale, in object
+space N taken there and the vector brought back as a direction; the material output's
+Displacement becomes a bump through the compiler (``shaders``: displacement as bump).
+"""
+from __future__ import annotations
+
+import math
+
+from ...jit import device
+from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
+from .input_nodes import normal_to_object, normal_to_world, transform_direction
+from .math_nodes import safe_normalize
+from .nodes import OFFSETS, SPACE_OBJECT
+
+_BUMP_STRENGTH = OFFSETS["Bump"]["Strength"]
+_BUMP_DISTANCE = OFFSETS["Bump"]["Distance"]
+_BUMP_WIDTH = OFFSETS["Bump"]["Filter Width"]
+_BUMP_HEIGHT = OFFSETS["Bump"]["Height"]
+_BUMP_HEIGHT_DX = OFFSETS["Bump"]["Height_dx"]
+_BUMP_HEIGHT_DY = OFFSETS["Bump"]["Height_dy"]
+_BUMP_NORMAL = OFFSETS["Bump"]["Normal"]
+_BUMP_INVERT = OFFSETS["Bump"]["prop:invert"]
+_BUMP_OBJECT = OFFSETS["Bump"]["prop:use_object_space"]
+_DISP_HEIGHT = OFFSETS["Displacement"]["Height"]
+_DISP_MIDLEVEL = OFFSETS["Displacement"]["Midlevel"]
+_DISP_SCALE = OFFSETS["Displacement"]["Scale"]
+_DISP_NORMAL = OFFSETS["Displacement"]["Normal"]
+_DISP_SPACE = OFFSETS["Displacement"]["prop:space"]
+
+
+@device
+def make_orthonormals(nx, ny, nz):
+    """Cycles' make_orthonormals: a = normalize((1, 1, 1) x N) (or (-1, 1, 1) x N when the
+    components are equal), b = N x a."""
+    if nx != ny or nx != nz:
+        ax, ay, az = nz - ny, nx - nz, ny - nx
+    else:
+        ax, ay, az = nz - ny, nx + nz, -ny - nx
+    ax, ay, az = safe_normalize(ax, ay, az)
+    return ax, ay, az, ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
+
+
+@device
+def differentials(sd):
+    """dPdx, dPdy at the point from its compact footprint (differential_from_compact)."""
+    ax, ay, az, bx, by, bz = make_orthonormals(sd.ngx, sd.ngy, sd.ngz)
+    d = sd.dp
+    return d * ax, d * ay, d * az, d * bx, d * by, d * bz
+
+
+@device
+def bump_point(sd, tex, width, axis):
+    """The shading point moved by ``width`` times dPdx (axis 1) or dPdy (axis 2), with its
+    barycentrics on the triangle: what a Bump node's Height sees in its x or y sample."""
+    xx, xy, xz, yx, yy, yz = differentials(sd)
+    if axis == 1:
+        ex, ey, ez = width * xx, width * xy, width * xz
+    else:
+        ex, ey, ez = width * yx, width * yy, width * yz
+    u, v = sd.u, sd.v
+    p = sd.prim
+    if p >= 0:
+        # Solve e = du e1 + dv e2 in the triangle's plane (Cramer's rule about its normal).
+        t = tex.tris[p]
+        v0, v1, v2 = tex.verts[t[0]], tex.verts[t[1]], tex.verts[t[2]]
+        e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
+        e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+        nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+        den = nx * nx + ny * ny + nz * nz
+        if den > 0.0:
+            # On a back face Cycles has negated dPdu and dPdv before solving for du, dv, so
+            # its attributes (UV maps, colours, the Texture Coordinate's Normal) move the
+            # other way than P: kept, to agree with it.
+            sign = -1.0 if sd.backfacing else 1.0
+            u += sign * ((ey * e2z - ez * e2y) * nx + (ez * e2x - ex * e2z) * ny + (ex * e2y - ey * e2x) * nz) / den
+            v += sign * ((e1y * ez - e1z * ey) * nx + (e1z * ex - e1x * ez) * ny + (e1x * ey - e1y * ex) * nz) / den
+    return ShadingData(sd.px + ex, sd.py + ey, sd.pz + ez, sd.nx, sd.ny, sd.nz, sd.ngx, sd.ngy, sd.ngz,
+                       sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
+                       sd.refractive_caustics, sd.bump_correction, sd.prim, u, v, sd.obj,
+                       sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
+                       sd.transmission_depth, sd.transparent_depth, sd.dp)
+
+
+@device
+def with_normal(sd, nx, ny, nz):
+    """``sd`` with shading normal n: displacement as bump sets it before the surface runs."""
+    return ShadingData(sd.px, sd.py, sd.pz, nx, ny, nz, sd.ngx, sd.ngy, sd.ngz,
+                       sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
+                       sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u, sd.v, sd.obj,
+                       sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
+                       sd.transmission_depth, sd.transparent_depth, sd.dp)
+
+
+@device
+def bump_normal(regs, b, sd, tex):
+    """Cycles' svm_node_set_bump: the bumped normal from the three heights."""
+    nx, ny, nz = regs[b + _BUMP_NORMAL], regs[b + _BUMP_NORMAL + 1], regs[b + _BUMP_NORMAL + 2]
+    if nx == 0.0 and ny == 0.0 and nz == 0.0:
+        nx, ny, nz = sd.nx, sd.ny, sd.nz
+    xx, xy, xz, yx, yy, yz = differentials(sd)
+    object_space = regs[b + _BUMP_OBJECT] != 0.0 and sd.obj >= 0
+    if object_space:
+        row = tex.objects[sd.obj]
+        nx, ny, nz = normal_to_object(row, nx, ny, nz)
+        xx, xy, xz = transform_direction(row, OBJ_INVERSE, xx, xy, xz)
+        yx, yy, yz = transform_direction(row, OBJ_INVERSE, yx, yy, yz)
+    rxx, rxy, rxz = yy * nz - yz * ny, yz * nx - yx * nz, yx * ny - yy * nx
+    ryx, ryy, ryz = ny * xz - nz * xy, nz * xx - nx * xz, nx * xy - ny * xx
+    h_c = regs[b + _BUMP_HEIGHT]
+    dhx = regs[b + _BUMP_HEIGHT_DX] - h_c
+    dhy = regs[b + _BUMP_HEIGHT_DY] - h_c
+    det = xx * rxx + xy * rxy + xz * rxz
+    scale = regs[b + _BUMP_DISTANCE]
+    if regs[b + _BUMP_INVERT] != 0.0:
+        scale = -scale
+    strength = max(regs[b + _BUMP_STRENGTH], 0.0)
+    k = scale * (-1.0 if det < 0.0 else 1.0)
+    m = regs[b + _BUMP_WIDTH] * abs(det)
+    ox, oy, oz = safe_normalize(m * nx - k * (dhx * rxx + dhy * ryx), m * ny - k * (dhx * rxy + dhy * ryy),
+                                m * nz - k * (dhx * rxz + dhy * ryz))
+    if (ox == 0.0 and oy == 0.0 and oz == 0.0) or not (math.isfinite(ox) and math.isfinite(oy)
+                                                         and math.isfinite(oz)):
+        ox, oy, oz = nx, ny, nz
+    else:
+        ox, oy, oz = safe_normalize(strength * ox + (1.0 - strength) * nx, strength * oy + (1.0 - strength) * ny,
+                                    strength * oz + (1.0 - strength) * nz)
+    if object_space:
+        ox, oy, oz = normal_to_world(tex.objects[sd.obj], ox, oy, oz)
+    return ox, oy, oz
+
+
+@device
+def displacement(regs, b, sd, tex):
+    """Cycles' svm_node_displacement: the displacement vector (world space)."""
+    nx, ny, nz = regs[b + _DISP_NORMAL], regs[b + _DISP_NORMAL + 1], regs[b + _DISP_NORMAL + 2]
+    if nx == 0.0 and ny == 0.0 and nz == 0.0:
+        nx, ny, nz = sd.nx, sd.ny, sd.nz
+    f = (regs[b + _DISP_HEIGHT] - regs[b + _DISP_MIDLEVEL]) * regs[b + _DISP_SCALE]
+    if int(regs[b + _DISP_SPACE]) == SPACE_OBJECT and sd.obj >= 0:
+        row = tex.objects[sd.obj]
+        nx, ny, nz = normal_to_object(row, nx, ny, nz)
+        return transform_direction(row, OBJ_MATRIX, nx * f, ny * f, nz * f)
+    return nx * f, ny * f, nz * f

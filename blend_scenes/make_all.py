@@ -43,6 +43,7 @@ SCENES = (
     "world_hdri_sun",
     "texture_image",
     "texture_normal_map",
+    "texture_bump",
 )
 
 

@@ -88,6 +88,27 @@ def test_missing_bump_shadowing_is_caught(renders):
     assert np.all(a.frame_rejected) and np.all(a.frame_rel_bias > 0)
 
 
+def _unlinked(material, socket_owner, socket):
+    def edit(scene):
+        tree = bpy.data.materials[material].node_tree
+        node = next(n for n in tree.nodes if n.bl_idname == socket_owner)
+        for link in list(node.inputs[socket].links):
+            tree.links.remove(link)
+    return edit
+
+
+@pytest.mark.parametrize("what,edit", [
+    ("Suzanne not bumped", _unlinked("Suzanne", "ShaderNodeBsdfPrincipled", "Normal")),
+    ("Ball without displacement as bump", _unlinked("Ball", "ShaderNodeOutputMaterial", "Displacement")),
+])
+def test_missing_bump_is_caught(renders, what, edit):
+    """Without its Bump node, or its displacement as bump, a surface is shaded smooth: the
+    blocks over it differ."""
+    result = renders.compare("texture_bump", what, edit)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
 def test_cycles_agrees_with_itself_across_seeds(blend, renders):
     name = blend.stem

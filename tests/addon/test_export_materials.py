@@ -269,3 +269,27 @@ def test_material_settings_cycles_reads(scene, fake_session):
     mat.cycles.use_bump_map_correction = False
     m, _ = exported(fake_session, mat)
     assert (m.use_transparent_shadow, m.use_bump_map_correction) == (False, False)
+
+
+@pytest.mark.parametrize("method", ["BUMP", "BOTH", "DISPLACEMENT"])
+def test_displacement_is_exported_as_bump(scene, fake_session, method):
+    """The output's Displacement is kept for Cycles' automatic bump ('Bump Only'; 'Displacement
+    and Bump' warned: only its bump is rendered); 'Displacement Only' is warned and dropped."""
+    mat = principled(f"Displaced {method}")
+    mat.displacement_method = method
+    tree = mat.node_tree
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    disp = tree.nodes.new("ShaderNodeDisplacement")
+    tree.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+    tree.links.new(disp.outputs["Displacement"], tree.nodes["Material Output"].inputs["Displacement"])
+    m, warnings = exported(fake_session, mat)
+    assert m.displacement_method == method
+    if method == "DISPLACEMENT":
+        assert m.displacement is None
+    else:
+        assert m.nodes[m.displacement.node].type == "Displacement"
+        assert m.nodes[m.nodes[m.displacement.node].inputs["Height"].node].type == "TexNoise"
+    if method == "BUMP":
+        assert warnings == []
+    else:
+        assert len(warnings) == 1 and "true displacement" in warnings[0] and "not displaced" in warnings[0]

@@ -175,7 +175,7 @@ class MCEngine(bpy.types.RenderEngine):
         self.update_stats("", "Exporting scene")
         start = time.perf_counter()
         try:
-            exported = export.export(depsgraph)
+            exported = export.export(depsgraph, frame_set=self.frame_set)
         except Exception as exc:
             self._fail(_describe(exc, "exporting the scene"), exc)
             return None, None

@@ -469,6 +469,30 @@ def add_empty(scene, name, parent=None, **transform):
     return obj
 
 
+def animate(obj, data_path, keys):
+    """Keyframe ``obj.<data_path>`` at each ``(frame, value)`` with linear interpolation
+    (``data_path`` may go through sub-structures, e.g. ``"data.lens"``)."""
+    *owners, attribute = data_path.split(".")
+    target = obj
+    for name in owners:
+        target = getattr(target, name)
+    for frame, value in keys:
+        setattr(target, attribute, value)
+        target.keyframe_insert(attribute, frame=frame)
+    make_linear(target.id_data)
+
+
+def make_linear(id_data):
+    """Every keyframe of ``id_data``'s action interpolates linearly (keyframe_insert makes
+    Bezier keys whatever the preferences say when Blender runs in the background)."""
+    for layer in id_data.animation_data.action.layers:
+        for strip in layer.strips:
+            for bag in strip.channelbags:
+                for fcurve in bag.fcurves:
+                    for point in fcurve.keyframe_points:
+                        point.interpolation = "LINEAR"
+
+
 def look_at(obj, target):
     """Rotate ``obj`` so that its local -Z axis points at ``target`` (+Y stays up)."""
     direction = Vector(target) - Vector(obj.location)

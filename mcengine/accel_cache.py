@@ -6,7 +6,9 @@ render the same triangles again: they reuse the Embree BVH of the previous
 render instead of building it anew.  The triangles are recognised by a hash
 of the vertex and index arrays (BLAKE2b, about 1 ms per MB, far below the
 cost of a build).  One BVH is kept, the last one built; it is dropped before
-a different one is built, so at most one extra BVH stays in memory.
+a different one is built, so at most one extra BVH stays in memory.  A scene
+with objects moving during the shutter is never reused nor kept: its moving
+triangles have BVHs of their own (``kernels.motion``) that the hash does not see.
 """
 from __future__ import annotations
 
@@ -33,9 +35,14 @@ def _digest(vertices: np.ndarray, triangles: np.ndarray) -> bytes:
     return h.digest()
 
 
-def accel_for(vertices, triangles) -> tuple[Accel, bool]:
-    """A BVH of these triangles and whether it was reused (True) or built (False)."""
+def accel_for(vertices, triangles, motion=None) -> tuple[Accel, bool]:
+    """A BVH of these triangles (with the moving ones of ``motion``, a
+    ``kernels.motion.MotionData``) and whether it was reused (True) or built (False)."""
     global _last
+    if motion is not None and len(motion.tri_slot):
+        with _lock:
+            _last = None           # free the old BVH; this one is not kept
+        return Accel(vertices, triangles, motion), False
     key = _digest(vertices, triangles)
     with _lock:
         if _last is not None and _last[0] == key:

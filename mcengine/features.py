@@ -21,6 +21,11 @@ caustic paths        lights, a glossy/glass/refraction caster Filter Glossy and 
                                                               Path + Light Tracing
 ==================== ======================================== ======================================
 
+The camera's effects cost nothing when absent without a flag: no lens sample is
+drawn for an aperture of 0, no ray time without an open shutter, and only the
+objects that move during the shutter are intersected at each ray's time; the
+plan names them (``camera``).
+
 Besides the effects, the plan lists what the scene holds: light types, the
 kinds of surface (read from the materials' shader graphs) and the materials
 whose shaders evaluate nodes at every hit (textures, inputs) rather than only
@@ -39,6 +44,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .kernels.motion import moves
 from .kernels.state import (
     CFG_CAUSTICS,
     CFG_LAMPS_HIT,
@@ -71,6 +77,7 @@ class EffectsPlan:
     images: int = 0                # images the shaders read
     world_shader: bool = False     # the world varies (its shader runs for escaped rays)
     world_sampled: bool = False    # the world is a light for next-event estimation (its map)
+    camera: tuple = ()             # "depth of field", "motion blur (...)": what the camera sees
     # The effects (see the module docstring); each is a kernel flag.
     nee: bool = False
     lamps_hit: bool = False
@@ -112,8 +119,9 @@ class EffectsPlan:
                     if self.textures else "no textures")
         if self.images:
             textures += f", {self.images} image{'s' if self.images > 1 else ''}"
+        camera = f"; {', '.join(self.camera)}" if self.camera else ""
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
-                f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures} | "
+                f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures}{camera} | "
                 f"simulated: {', '.join(on) if on else 'nothing'} | "
                 f"skipped: {', '.join(off) if off else 'nothing'}")
 
@@ -173,6 +181,7 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
     return EffectsPlan(
         lobes=tuple(k for k in LOBE_ORDER if k in kinds),
         textures=textures,
+        camera=camera_effects(scene),
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
@@ -185,6 +194,23 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         mis=nee and (lamps_hit or emissive_triangles > 0 or world_sampled),
         caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
     )
+
+
+def camera_effects(scene) -> tuple:
+    """Depth of field (an aperture), and motion blur with what moves while the shutter is open."""
+    out = ["depth of field"] if scene.camera.aperture_size > 0.0 else []
+    mb = scene.motion_blur
+    if mb is not None:
+        what = []
+        steps = np.asarray(scene.camera.motion, float)
+        if (len(steps) and np.any(steps != steps[len(steps) // 2])) or \
+                tuple(scene.camera.view_scale_motion) != (1.0, 1.0):
+            what.append("camera")
+        n = sum(1 for om in mb.objects if moves(om, scene.geometry.vertices))
+        if n:
+            what.append(f"{n} moving object{'s' if n > 1 else ''}")
+        out.append(f"motion blur ({', '.join(what) if what else 'nothing moves'})")
+    return tuple(out)
 
 
 LOBE_ORDER = ("diffuse", "rough diffuse", "sheen", "translucent", "rough glossy", "sharp glossy",

@@ -21,6 +21,8 @@
   every array as a struct and checks an error status), which summed over the
   dozen helpers of a shading step made it several times slower.  Kernels
   compile more slowly; the cache keeps that a one-off.
+* ``builder``: host-side code that builds and returns arrays once per render
+  (the motion-blur BVH); it keeps numba's reference counting.
 * ``function``: the few large steps (running a shader, evaluating or
   sampling a closure list) are called, not inlined: they cost far more than a
   call, and inlining them into every caller made compilation take many
@@ -96,5 +98,7 @@ def _cached(decorator):
 
 
 device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=False))
+# Host-side builders that allocate their results (acceleration structures), run once per render.
+builder = _cached(njit(cache=True, error_model="numpy"))
 function = _cached(njit(cache=True, error_model="numpy", _nrt=False))
 kernel = _cached(njit(cache=True, nogil=True, error_model="numpy", _nrt=False))

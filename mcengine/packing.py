@@ -24,6 +24,7 @@ from .kernels.background import bake_background
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
+from .kernels.motion import pack_motion
 from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, PassData
 from .kernels.sampling import SAMPLER_INDEPENDENT, filter_table
 from .kernels.shading import emission_estimates
@@ -125,7 +126,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     world_varies = bool(np.any(shaders.ops[start:end, 0] == OP_NODE))
     mat_index = np.ascontiguousarray(g.material_index, np.int32)
     film = scene.film
-    camera = pack_camera(scene.camera, film)
+    camera = pack_camera(scene.camera, film, scene.motion_blur)
     none_f, none_i = np.zeros(0), np.zeros(0, np.int32)
     normals = np.ascontiguousarray(g.normals, np.float32)
     sc = SceneData(
@@ -141,6 +142,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
                         tri_object=np.ascontiguousarray(g.object_index, np.int32),
                         objects=pack_objects(g), camera=camera, images=images.info,
                         pix8=images.pix8, pixf=images.pixf, verts=verts, tris=tris),
+        motion=pack_motion(g, scene.motion_blur.objects if scene.motion_blur else []),
         bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)))
 
     # The world as a light: its importance map, when its radiance varies.

@@ -33,7 +33,8 @@ from .passes import RenderPasses
 
 __all__ = [
     "SceneError", "ObjectPassInfo", "Geometry", "Link", "ShaderNode", "Material", "Image", "Light",
-    "Camera", "World", "Film", "Integrator", "SceneDescription", "RenderPasses", "Denoising",
+    "Camera", "MotionBlur", "ObjectMotion", "World", "Film", "Integrator", "SceneDescription",
+    "RenderPasses", "Denoising",
 ]
 
 LIGHT_TYPES = ("POINT", "SPOT", "SUN", "AREA")
@@ -392,6 +393,64 @@ class Camera:
     aperture_blades: int = 0         # polygonal aperture with this many blades (< 3: a disk)
     aperture_rotation: float = 0.0   # rotation of the polygon, radians
     aperture_ratio: float = 1.0      # anamorphic squeeze: lens x is divided by it
+    # Motion blur: the world matrices at the camera's motion steps, spread evenly over the
+    # shutter (an odd number, the middle one the frame's; empty: the camera does not move),
+    # and the view plane's size at shutter open and close relative to the frame's when
+    # the focal length changes (perspective; Cycles' fov_pre and fov_post).
+    motion: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 4)))
+    view_scale_motion: tuple = (1.0, 1.0)
+
+
+@dataclass
+class ObjectMotion:
+    """How one object of the geometry moves while the shutter is open.
+
+    ``object`` is its index in ``Geometry.object_names``: its triangles are those
+    of that ``object_index``, and their vertices are ``vertices`` = (first,
+    count) of ``Geometry.vertices``, which hold the positions at the frame.
+    Motion is given at S motion steps spread evenly over the shutter (S odd,
+    the middle step is the frame):
+
+    matrices   (S, 4, 4)  world matrices (metres) at the steps; empty when only
+                          the mesh deforms
+    positions  (S, count, 3) float32  the vertices at the steps, placed with the
+                          frame's matrix (the deformation), or None
+    normals    (S, T_o, 3, 3) float32  their corner shading normals likewise, for
+                          the object's triangles in increasing order, or None
+
+    At a time between two steps, the matrix is interpolated as Cycles does
+    (``kernels.motion``) and applied to the positions, which are interpolated
+    linearly; the result is ``M(t) M(frame)^-1 positions(t)``.
+    """
+
+    object: int
+    vertices: tuple = (0, 0)
+    matrices: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 4)))
+    positions: np.ndarray | None = None
+    normals: np.ndarray | None = None
+
+    @property
+    def steps(self) -> int:
+        return len(self.matrices) if len(self.matrices) else len(self.positions)
+
+
+@dataclass
+class MotionBlur:
+    """An open shutter: rays get times, and what moves is seen at those times.
+
+    ``shutter_curve`` is Blender's shutter curve (``render.motion_blur_shutter_curve``)
+    sampled at i / 256, i = 0..256, as Cycles samples it (None: flat); the ray
+    times follow its inverted CDF over [0, 1], the whole shutter.  With
+    ``rolling_shutter`` the rows are read out top to bottom, ``duration`` being
+    the share of the shutter each row stays open (Cycles' rolling shutter).
+    ``objects`` are the objects that move; the camera's motion is the camera's.
+    Lamps do not move during the shutter, as in Cycles.
+    """
+
+    shutter_curve: np.ndarray | None = None
+    rolling_shutter: bool = False
+    rolling_shutter_duration: float = 0.1
+    objects: list = field(default_factory=list)
 
 
 WORLD_SAMPLING = ("NONE", "AUTOMATIC", "MANUAL")
@@ -505,6 +564,7 @@ class SceneDescription:
     integrator: Integrator = field(default_factory=Integrator)
     passes: RenderPasses = field(default_factory=RenderPasses)
     denoising: Denoising = field(default_factory=Denoising)
+    motion_blur: MotionBlur | None = None     # None: the shutter is closed, every ray at time 0.5
     warnings: list = field(default_factory=list)
     images: dict = field(default_factory=dict)       # name -> Image
 
@@ -601,6 +661,24 @@ class SceneDescription:
             _check_number("camera", attr, getattr(c, attr))
         _check_number("camera", "clip_start", c.clip_start, lo=0.0)
         _check_number("camera", "clip_end", c.clip_end, lo=c.clip_start + 1e-12)
+        motion = np.asarray(c.motion, float)
+        if motion.size and (motion.ndim != 3 or motion.shape[1:] != (4, 4) or len(motion) % 2 == 0):
+            raise SceneError(f"camera: motion must be an odd number of 4x4 matrices, got {motion.shape}")
+        for m in motion:
+            _check_matrix("camera motion", m, axes=True)
+        _check_vector("camera", "view_scale_motion", c.view_scale_motion, 2)
+        if min(c.view_scale_motion) <= 0.0:
+            raise SceneError(f"camera: view_scale_motion must be positive, got {c.view_scale_motion}")
+        if self.motion_blur is not None:
+            mb = self.motion_blur
+            if mb.shutter_curve is not None:
+                curve = np.asarray(mb.shutter_curve, float)
+                if curve.shape != (257,) or not np.all(np.isfinite(curve)) or not np.any(curve):
+                    raise SceneError("motion blur: shutter_curve must be 257 finite values, not all 0")
+            _check_number("motion blur", "rolling_shutter_duration", mb.rolling_shutter_duration,
+                          lo=0.0, hi=1.0)
+            for om in mb.objects:
+                _check_object_motion(om, self.geometry)
         if c.sensor_fit not in ("AUTO", "HORIZONTAL", "VERTICAL"):
             raise SceneError(f"camera: unknown sensor_fit {c.sensor_fit!r} (AUTO, HORIZONTAL, VERTICAL)")
         _check_number("camera", "aperture_size", c.aperture_size, lo=0.0)
@@ -641,6 +719,8 @@ class SceneDescription:
             "integrator": dataclasses.asdict(self.integrator),
             "passes": dataclasses.asdict(self.passes),
             "denoising": dataclasses.asdict(self.denoising),
+            "motion_blur": (None if self.motion_blur is None
+                            else _plain(dataclasses.asdict(self.motion_blur))),
             "warnings": list(self.warnings),
         }
         matrix, texspace, info = g.object_arrays()
@@ -747,6 +827,14 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
                                for k, v in d.items()}))
     cam = dict(meta["camera"])
     cam["matrix_world"] = np.array(cam["matrix_world"], float)
+    cam["motion"] = np.array(cam.get("motion", []), float).reshape(-1, 4, 4)
+    cam["view_scale_motion"] = tuple(cam.get("view_scale_motion", (1.0, 1.0)))
+    motion_blur = meta.get("motion_blur")
+    if motion_blur is not None:
+        motion_blur = dict(motion_blur)
+        if motion_blur.get("shutter_curve") is not None:
+            motion_blur["shutter_curve"] = np.array(motion_blur["shutter_curve"], float)
+        motion_blur = MotionBlur(**motion_blur)
     film = dict(meta["film"])
     if film.get("region") is not None:
         film["region"] = tuple(film["region"])
@@ -762,7 +850,7 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
         passes=RenderPasses(**{k: (tuple(v) if isinstance(v, list) else v)
                                for k, v in meta.get("passes", {}).items()}),
         denoising=Denoising(**meta.get("denoising", {})),
-        warnings=list(meta.get("warnings", [])))
+        motion_blur=motion_blur, warnings=list(meta.get("warnings", [])))
 
 
 def _plain(d: dict) -> dict:
@@ -825,6 +913,37 @@ def _check_image(name, im) -> None:
         raise SceneError(f"{where}: unknown colour space {im.colorspace!r} ({', '.join(IMAGE_COLORSPACES)})")
     if im.alpha not in IMAGE_ALPHA_MODES:
         raise SceneError(f"{where}: unknown alpha mode {im.alpha!r} ({', '.join(IMAGE_ALPHA_MODES)})")
+
+
+def _check_object_motion(om: ObjectMotion, g: Geometry) -> None:
+    """An ObjectMotion names an existing object, its own vertices and consistent steps."""
+    if not 0 <= om.object < max(len(g.object_names), 1):
+        raise SceneError(f"motion blur: object {om.object} does not exist")
+    where = f"motion of object '{g.object_names[om.object]}'" if g.object_names else "motion"
+    first, count = (int(v) for v in om.vertices)
+    if first < 0 or count < 0 or first + count > g.vertices.shape[0]:
+        raise SceneError(f"{where}: vertices {om.vertices} are outside the geometry")
+    mats = np.asarray(om.matrices, float)
+    if mats.size:
+        if mats.ndim != 3 or mats.shape[1:] != (4, 4) or len(mats) % 2 == 0:
+            raise SceneError(f"{where}: matrices must be an odd number of 4x4 matrices")
+        for m in mats:
+            _check_matrix(where, m)
+    tris = g.triangles[g.object_index == om.object]
+    if len(tris) and (tris.min() < first or tris.max() >= first + count):
+        raise SceneError(f"{where}: its triangles use vertices outside {om.vertices}")
+    if om.positions is None:
+        if not mats.size:
+            raise SceneError(f"{where}: neither matrices nor positions")
+        return
+    steps = len(mats) if mats.size else len(om.positions)
+    pos = np.asarray(om.positions)
+    if pos.shape != (steps, count, 3) or steps % 2 == 0 or steps < 3:
+        raise SceneError(f"{where}: positions have shape {pos.shape}, expected ({steps}, {count}, 3)")
+    if om.normals is None or np.asarray(om.normals).shape != (steps, len(tris), 3, 3):
+        raise SceneError(f"{where}: normals must have shape ({steps}, {len(tris)}, 3, 3)")
+    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(om.normals))):
+        raise SceneError(f"{where}: positions or normals are not finite")
 
 
 def _check_graph(where: str, material: Material) -> None:

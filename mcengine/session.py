@@ -153,15 +153,15 @@ class _TimedAccel:
         self._accel = accel
         self._clock = clock
 
-    def closest(self, o, d, t):
+    def closest(self, o, d, t, times=None):
         t0 = time.perf_counter()
-        r = self._accel.closest(o, d, t)
+        r = self._accel.closest(o, d, t, times)
         self._clock[0] += time.perf_counter() - t0
         return r
 
-    def occluded(self, o, d, t):
+    def occluded(self, o, d, t, times=None):
         t0 = time.perf_counter()
-        r = self._accel.occluded(o, d, t)
+        r = self._accel.occluded(o, d, t, times)
         self._clock[0] += time.perf_counter() - t0
         return r
 
@@ -275,7 +275,7 @@ class RenderSession:
         self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
         self.accel, self.stats.extra["bvh_reused"] = accel_cache.accel_for(
-            scene.geometry.vertices, scene.geometry.triangles)
+            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion)
         self.stats.time_bvh = time.perf_counter() - t0
         t0 = time.perf_counter()
         self._warm_up()

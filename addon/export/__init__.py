@@ -23,6 +23,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from mcengine.kernels.camera import view_plane
 from mcengine.scene import SceneDescription, SceneError
 
 __all__ = ["ExportError", "ExportContext", "ExportResult", "PARTS", "export"]
@@ -82,15 +85,18 @@ class ExportResult:
     ignored: list = field(default_factory=list)
 
 
-def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = None
-           ) -> ExportResult:
+def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = None,
+           frame_set=None) -> ExportResult:
     """Export everything the renderer needs from an evaluated depsgraph.
 
     ``camera`` replaces the scene camera (the viewport's view).  With a
     ``previous`` export, only ``parts`` (names of :data:`PARTS`) are exported
     again and the rest is reused; materials alone are re-exported only if the
     objects still use the same materials in the same order, else the objects
-    are exported too.
+    are exported too.  ``frame_set(frame, subframe)`` evaluates the depsgraph
+    at another time (``RenderEngine.frame_set``; by default ``scene.frame_set``):
+    a final render with motion blur samples the scene at its motion steps with
+    it (the viewport, like Cycles', renders without motion blur).
 
     Raises
     ------
@@ -98,10 +104,17 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
         If the scene cannot be rendered at all (no camera, panoramic camera).
     """
     from . import camera as cameras
-    from . import passes, settings, world
+    from . import motion, passes, settings, world
 
     scene = depsgraph.scene
+    if frame_set is None:
+        def frame_set(frame, subframe):
+            scene.frame_set(frame, subframe=subframe)
     ctx = ExportContext(scene)
+    shutter = motion.shutter(scene, depsgraph.view_layer) if camera is None else None
+    if shutter is not None and shutter.position != "CENTER":
+        # Cycles takes the scene (lamps, materials, what does not move) at the shutter's middle.
+        frame_set(int(shutter.middle // 1), shutter.middle % 1)
     cam = camera if camera is not None else cameras.export_camera(ctx, depsgraph)  # may fail
     old = previous.scene if previous is not None else None
     parts = PARTS if old is None else set(parts)
@@ -109,8 +122,9 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
         material_list = _materials_in_order(ctx, depsgraph)
         if [m.name for m in material_list] != [m.name for m in old.materials]:
             parts.add("objects")
+    layout = None
     if "objects" in parts:
-        geometry, material_list, walked_lights = _walk(ctx, depsgraph)
+        geometry, material_list, walked_lights, layout = _walk(ctx, depsgraph, shutter=shutter)
     else:
         geometry, walked_lights = old.geometry, None
         if "materials" not in parts:
@@ -137,14 +151,17 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     else:
         desc.passes, desc.denoising = old.passes, old.denoising
     desc.images = _images_used(desc, {**(old.images if old is not None else {}), **ctx.images})
+    if shutter is not None and layout is not None:
+        desc.motion_blur = _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam)
     desc.warnings = list(ctx.warnings)
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
 
-def _walk(ctx, depsgraph, meshes: bool = True):
-    """One pass over the instances: (geometry, materials, lights); geometry and materials
-    are None without ``meshes``."""
-    from . import lights, materials, mesh
+def _walk(ctx, depsgraph, meshes: bool = True, shutter=None):
+    """One pass over the instances: (geometry, materials, lights, layout); geometry,
+    materials and layout (``MeshCollector.layout``, tagged with each instance's motion
+    settings when the ``shutter`` is open) are None without ``meshes``."""
+    from . import lights, materials, mesh, motion
 
     table = materials.MaterialTable(ctx)
     collector = mesh.MeshCollector(ctx, table) if meshes else None
@@ -159,12 +176,18 @@ def _walk(ctx, depsgraph, meshes: bool = True):
                 if light is not None:
                     light_list.append(light)
             elif collector is not None:
-                collector.add(inst, _instance_name(inst))
+                tag = None
+                if shutter is not None:
+                    parent = inst.parent if inst.is_instance else None
+                    steps = motion.motion_steps(ob.original, parent.original if parent else None)
+                    tag = (motion.instance_key(inst), steps,
+                           steps > 0 and motion.deforms(ob, parent, depsgraph.scene))
+                collector.add(inst, _instance_name(inst), tag)
         except Exception as exc:  # one bad object must not abort the render
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
     if collector is None:
-        return None, None, light_list
-    return collector.geometry(), table.materials, light_list
+        return None, None, light_list, None
+    return collector.geometry(), table.materials, light_list, collector.layout
 
 
 def _materials_in_order(ctx, depsgraph) -> list:
@@ -187,6 +210,44 @@ def _images_used(desc: SceneDescription, images: dict) -> dict:
     graphs = [m.nodes for m in desc.materials] + [getattr(desc.world, "nodes", [])]
     names = {str(n.props.get("image", "")) for nodes in graphs for n in nodes}
     return {name: im for name, im in images.items() if name in names}
+
+
+def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
+    """The scene's MotionBlur; sets the camera's motion (the frame is set back afterwards)."""
+    from . import camera, mesh, motion
+
+    s = ctx.unit_scale
+    objects = {}
+    for index, (tag, vertices, local, slots, matrix) in enumerate(layout):
+        key, steps, deform = tag        # the layout follows the geometry's object order
+        objects[key] = (index, steps, deform, vertices, local, slots, matrix)
+
+    def read_mesh(ob, slots):
+        return mesh.read_local_mesh(ob, slots)
+
+    def place(local, matrix):
+        placed = mesh.transform_instances(local, matrix[None], s, [""])
+        return placed.vertices, placed.normals
+
+    ob = depsgraph.scene.camera.evaluated_get(depsgraph)
+    camera_steps = motion.motion_steps(ob.original)
+    frame_size = camera.frame_size(depsgraph.scene.render)
+    aspect = (depsgraph.scene.render.pixel_aspect_x, depsgraph.scene.render.pixel_aspect_y)
+    size = view_plane(ob.data, *frame_size, aspect)[0]
+    moving, camera_matrices, view_sizes = motion.sample_motion(
+        ctx, depsgraph, frame_set, shutter, objects, camera_steps, read_mesh, place)
+    for om in moving:
+        om.matrices = om.matrices.copy()
+        om.matrices[:, :3, :] *= s
+    if camera_steps:
+        times = motion.step_times(camera_steps)
+        cam.motion = np.stack([cam.matrix_world if t == 0.0 else
+                               camera.without_scale(camera_matrices[t], s) for t in times])
+    if cam.type == "PERSP":
+        cam.view_scale_motion = (view_sizes.get(-1.0, size) / size, view_sizes.get(1.0, size) / size)
+    settings = shutter.settings()
+    settings.objects = moving
+    return settings
 
 
 def _instance_name(inst) -> str:

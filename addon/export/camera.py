@@ -30,7 +30,7 @@ from . import ExportError
 from .settings import cycles_settings
 
 __all__ = ["export_camera", "camera_from_view", "export_film", "frame_size", "border_region",
-           "focal_distance"]
+           "focal_distance", "without_scale"]
 
 MIN_FSTOP = 1e-5     # Cycles clamps the f-stop to this before dividing by it
 
@@ -48,7 +48,7 @@ def export_camera(ctx, depsgraph) -> Camera:
                           f"orthographic cameras only")
     s = ctx.unit_scale
     camera = Camera(
-        matrix_world=_without_scale(np.array(ob.matrix_world, np.float64), s),
+        matrix_world=without_scale(np.array(ob.matrix_world, np.float64), s),
         type=cam.type,
         lens=float(cam.lens),
         sensor_width=float(cam.sensor_width),
@@ -116,7 +116,7 @@ def camera_from_view(view_matrix, window_matrix, unit_scale: float = 1.0) -> Cam
         near, far = p[2, 3] / (p[2, 2] - 1.0), p[2, 3] / (p[2, 2] + 1.0)
     sensor = 36.0
     return Camera(
-        matrix_world=_without_scale(np.linalg.inv(view), unit_scale),
+        matrix_world=without_scale(np.linalg.inv(view), unit_scale),
         type="ORTHO" if ortho else "PERSP",
         lens=sensor / (2.0 * half_w), sensor_width=sensor, sensor_height=sensor * half_h / half_w,
         sensor_fit="HORIZONTAL",
@@ -166,7 +166,7 @@ def border_region(render) -> tuple:
     return x0, height - y1_up, x1, height - y0_up
 
 
-def _without_scale(m: np.ndarray, unit_scale: float) -> np.ndarray:
+def without_scale(m: np.ndarray, unit_scale: float) -> np.ndarray:
     """Normalise the rotation columns (drop object scale) and convert the translation to metres."""
     out = m.copy()
     lengths = np.linalg.norm(m[:3, :3], axis=0)

@@ -121,10 +121,13 @@ class MeshCollector:
         self._names: dict[tuple, list] = {}
         self._infos: dict[tuple, list] = {}
         self._passes: dict[tuple, list] = {}
+        self._tags: dict[tuple, list] = {}
+        # Per geometry object, after geometry(): (tag, (first vertex, count), LocalMesh, slots, matrix).
+        self.layout: list = []
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
         self._noted: dict[str, list] = {}
 
-    def add(self, inst, name: str) -> None:
+    def add(self, inst, name: str, tag=None) -> None:
         """Register one depsgraph instance (non-mesh data is ignored or noted).
 
         Parameters
@@ -132,6 +135,8 @@ class MeshCollector:
         inst : bpy.types.DepsgraphObjectInstance
         name : str
             Name of the instance for messages.
+        tag : object, optional
+            Returned with the instance's place in the geometry (``layout``).
         """
         ob = inst.object
         if ob.type in _UNSUPPORTED_DATA:
@@ -152,7 +157,7 @@ class MeshCollector:
             if mesh is not None and mesh.tangents_failed:
                 self._note(mesh.tangents_failed, ob.name)
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
-            self._passes[key] = []
+            self._passes[key], self._tags[key] = [], []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
@@ -160,6 +165,7 @@ class MeshCollector:
             self._infos[key].append([float(random_id & 0xFFFFFFFF), float(ob.pass_index),
                                      *(float(c) for c in ob.color)])
             self._passes[key].append(object_pass_info(ob))
+            self._tags[key].append(tag)
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -174,6 +180,15 @@ class MeshCollector:
         geometry = _place_all(parts, self._ctx.unit_scale)
         geometry.object_passes = [info for key, mesh in self._meshes.items() if mesh is not None
                                   for info in self._passes[key]]
+        # The instances' places in the geometry, in the order _place_all writes them.
+        self.layout = []
+        first = 0
+        for key, mesh in self._meshes.items():
+            if mesh is not None:
+                count = mesh.vertices.shape[0]
+                for tag, matrix in zip(self._tags[key], self._matrices[key]):
+                    self.layout.append((tag, (first, count), mesh, key[1], matrix))
+                    first += count
         return geometry
 
     def _note(self, feature: str, object_name: str) -> None:

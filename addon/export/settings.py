@@ -77,9 +77,6 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
     samples = int(cycles.samples)
     if cycles.use_layer_samples == "USE" and view_layer.samples > 0:
         samples = int(view_layer.samples)  # Cycles' per-view-layer sample override
-    if scene.render.use_motion_blur:
-        ctx.warn("motion blur is enabled: not supported yet; rendering the frame without it",
-                 "motion blur")
     return Integrator(
         samples=samples,
         seed=render_seed(cycles, scene),

@@ -104,6 +104,7 @@ def _push_child(nx, n_next, st, i, key, sp, wix, wiy, wiz, br, bg, bb, flags, mi
     nx.key[n_next] = key
     nx.pixel[n_next] = st.pixel[i]
     nx.root[n_next] = st.root[i]
+    nx.time[n_next] = st.time[i]
     nx.beta[n_next, 0], nx.beta[n_next, 1], nx.beta[n_next, 2] = br, bg, bb
     nx.bounce[n_next] = st.bounce[i] + 1
     nx.transparent[n_next] = st.transparent[i]
@@ -123,6 +124,7 @@ def _copy_node(nx, n_next, st, i, advance):
     nx.key[n_next] = st.key[i]
     nx.pixel[n_next] = st.pixel[i]
     nx.root[n_next] = st.root[i]
+    nx.time[n_next] = st.time[i]
     for c in range(3):
         nx.beta[n_next, c] = st.beta[i, c]
     nx.bounce[n_next] = st.bounce[i]
@@ -160,7 +162,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if p >= 0 and p == st.self_prim[i]:
             stats[ST_SELF_HITS] += 1
             n_next = _copy_node(nx, n_next, st, i,
-                                past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz))
+                                past_self_hit(sc, p, ox, oy, oz, dx, dy, dz, st.time[i]))
             continue
         root = st.root[i]
         flags = st.flags[i]
@@ -168,7 +170,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
         bounce = st.bounce[i]
         br, bg, bb = st.beta[i, 0], st.beta[i, 1], st.beta[i, 2]
-        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
+        t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i], st.time[i])
         direct = bounce <= 1
 
         if lamps_hit:
@@ -186,7 +188,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
             continue
         if sc.tri_area[p] <= 0.0:
             continue
-        sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+        sp = surface_point(sc, p, b1, b2, dx, dy, dz, st.time[i])
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
@@ -197,7 +199,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
                           depths, footprint)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
-            light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp.cos_o,
+            light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp,
                                flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,
                                res.er, res.eg, res.eb)
         if terminate or res.n == 0:
@@ -349,7 +351,7 @@ def trace_chunk_classic(pixels, spp, accel, sc, cfg, fcfg, buffers, film, stats,
         if not first:
             stats[ST_BOUNCE_RAYS] += n
         first = False
-        prim = accel.closest(cur.o32[:n], cur.d32[:n], cur.t32[:n])
+        prim = accel.closest(cur.o32[:n], cur.d32[:n], cur.t32[:n], cur.time[:n])
         n_next = 0
         for start in range(0, n, slice_nodes):
             end = min(n, start + slice_nodes)

@@ -16,6 +16,11 @@ threads tracing two batches use both cores.  Its limits shape this module:
 * a ray that re-hits the triangle it starts on (possible only through
   rounding, as triangles are flat) is detected by primitive id and traced
   again from just past that hit (``Accel.closest`` callers do this).
+
+embreex has no motion blur (no time on rays, no motion BVH).  Objects that
+move while the shutter is open (``kernels.motion``) are left out of the
+Embree scene and intersected exactly at each ray's time by the motion
+module's own BVHs; ``Accel`` merges the two, so the callers see one scene.
 """
 from __future__ import annotations
 
@@ -23,7 +28,8 @@ import math
 
 import numpy as np
 
-from ..jit import device
+from ..jit import device, kernel
+from .motion import moving_closest, moving_normals, moving_occluded, moving_triangle
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about
 # 32 float32 ulps, above the rounding of the origin to float32 (half an ulp
@@ -40,18 +46,27 @@ T_INFINITE = 1e30   # "no hit" distance; Embree's float32 tfar for unbounded ray
 
 
 class Accel:
-    """Embree BVH over the scene triangles.
+    """Embree BVH over the scene triangles, plus the moving ones.
 
     Parameters
     ----------
     vertices : (V, 3) float32
     triangles : (T, 3) int32
+    motion : kernels.motion.MotionData, optional
+        The moving objects; their triangles are intersected at each ray's time.
     """
 
-    def __init__(self, vertices, triangles):
+    def __init__(self, vertices, triangles, motion=None):
         self.num_triangles = int(len(triangles))
         self._scene = None
-        if self.num_triangles:
+        self._motion = motion if motion is not None and len(motion.tri_slot) else None
+        self._static_ids = None
+        if self._motion is not None:
+            self._static_ids = np.flatnonzero(self._motion.tri_slot < 0).astype(np.int32)
+            self._verts = np.asarray(vertices, np.float64)
+            self._tris = np.ascontiguousarray(triangles, np.int32)
+            triangles = np.asarray(triangles)[self._static_ids]
+        if len(triangles):
             from embreex import rtcore_scene
             from embreex.mesh_construction import TriangleMesh
             # Robust mode: Embree's watertight triangle test.  The fast mode lets
@@ -65,22 +80,54 @@ class Accel:
             # safe to do from two threads at once.
             self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
 
-    def closest(self, origins, directions, tfar):
+    def closest(self, origins, directions, tfar, time=None):
         """Primitive id of the closest hit within (0, tfar), or -1.
 
-        origins, directions : (n, 3) float32; tfar : (n,) float32.
+        origins, directions : (n, 3) float32; tfar : (n,) float32; time : (n,)
+        float64 in [0, 1] over the shutter (only moving objects look at it).
         """
         n = origins.shape[0]
         if self._scene is None or n == 0:
-            return np.full(n, -1, np.int32)
-        return self._scene.run(origins, directions, dists=tfar, query="INTERSECT")
+            prim = np.full(n, -1, np.int32)
+        else:
+            prim = self._scene.run(origins, directions, dists=tfar, query="INTERSECT")
+        if self._motion is None or n == 0:
+            return prim
+        if self._scene is not None:
+            prim = np.where(prim >= 0, self._static_ids[np.maximum(prim, 0)], -1).astype(np.int32)
+        best = np.empty(n)
+        hit_distances(self._verts, self._tris, origins, directions, tfar, prim, best)
+        moving_closest(self._motion, self._verts, self._tris, origins, directions,
+                       _times(time, n), best, prim)
+        return prim
 
-    def occluded(self, origins, directions, tfar):
-        """True where something blocks the segment (0, tfar)."""
+    def occluded(self, origins, directions, tfar, time=None):
+        """True where something blocks the segment (0, tfar) (at the ray's time)."""
         n = origins.shape[0]
         if self._scene is None or n == 0:
-            return np.zeros(n, np.bool_)
-        return self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
+            blocked = np.zeros(n, np.bool_)
+        else:
+            blocked = self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
+        if self._motion is not None and n:
+            moving_occluded(self._motion, self._verts, self._tris, origins, directions, tfar,
+                            _times(time, n), blocked)
+        return blocked
+
+
+def _times(time, n):
+    return np.full(n, 0.5) if time is None else np.ascontiguousarray(time, np.float64)
+
+
+@kernel
+def hit_distances(verts, tris, o32, d32, t32, prim, best):
+    """Distance of each ray's hit on triangle ``prim`` (``t32`` where there is none)."""
+    for i in range(prim.shape[0]):
+        best[i] = t32[i]
+        if prim[i] >= 0:
+            t, _, _ = intersect_prim(float(o32[i, 0]), float(o32[i, 1]), float(o32[i, 2]),
+                                     float(d32[i, 0]), float(d32[i, 1]), float(d32[i, 2]),
+                                     verts, tris, prim[i])
+            best[i] = t if math.isfinite(t) and t > 0.0 else 0.0
 
 
 @device
@@ -146,3 +193,44 @@ def intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p):
                               verts[a, 0], verts[a, 1], verts[a, 2],
                               verts[b, 0], verts[b, 1], verts[b, 2],
                               verts[c, 0], verts[c, 1], verts[c, 2])
+
+
+@device
+def is_moving(sc, p):
+    """Whether triangle p belongs to an object that moves during the shutter."""
+    return sc.motion.tri_slot.shape[0] != 0 and sc.motion.tri_slot[p] >= 0
+
+
+@device
+def prim_corners(sc, p, time):
+    """The corners of triangle p at ``time`` (9 floats, world space)."""
+    if is_moving(sc, p):
+        return moving_triangle(sc.motion, sc.verts, sc.tris, p, time)
+    a, b, c = sc.tris[p, 0], sc.tris[p, 1], sc.tris[p, 2]
+    v = sc.verts
+    return v[a, 0], v[a, 1], v[a, 2], v[b, 0], v[b, 1], v[b, 2], v[c, 0], v[c, 1], v[c, 2]
+
+
+@device
+def prim_normals(sc, p, time):
+    """The corner shading normals of triangle p at ``time`` (9 floats, world space)."""
+    if is_moving(sc, p):
+        return moving_normals(sc.motion, sc.verts, sc.tris, sc.normals, p, time)
+    n = sc.normals
+    return (n[p, 0, 0], n[p, 0, 1], n[p, 0, 2], n[p, 1, 0], n[p, 1, 1], n[p, 1, 2],
+            n[p, 2, 0], n[p, 2, 1], n[p, 2, 2])
+
+
+@device
+def prim_frame(sc, p, time):
+    """Unit geometric normal (from the winding) and area of triangle p at ``time``."""
+    if not is_moving(sc, p):
+        return sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2], sc.tri_area[p]
+    ax, ay, az, bx, by, bz, cx, cy, cz = moving_triangle(sc.motion, sc.verts, sc.tris, p, time)
+    e1x, e1y, e1z = bx - ax, by - ay, bz - az
+    e2x, e2y, e2z = cx - ax, cy - ay, cz - az
+    nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+    length = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if length <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0
+    return nx / length, ny / length, nz / length, 0.5 * length

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..jit import device
 from .closures.layout import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
+from .intersect import prim_corners, prim_frame
 from .lights import (
     L_FLAGS,
     L_MAX_BOUNCES,
@@ -115,15 +116,14 @@ def group_importance(group, px, py, pz):
 
 
 @device
-def sample_triangle_point(verts, tris, tri, u1, u2):
-    """Uniform point on triangle ``tri``: (x, y, z, b1, b2)."""
+def sample_triangle_point(sc, tri, u1, u2, time):
+    """Uniform point on triangle ``tri`` as it is at ``time``: (x, y, z, b1, b2)."""
     b1, b2 = uniform_triangle(u1, u2)
     b0 = 1.0 - b1 - b2
-    a, b, c = tris[tri, 0], tris[tri, 1], tris[tri, 2]
-    return (b0 * verts[a, 0] + b1 * verts[b, 0] + b2 * verts[c, 0],
-            b0 * verts[a, 1] + b1 * verts[b, 1] + b2 * verts[c, 1],
-            b0 * verts[a, 2] + b1 * verts[b, 2] + b2 * verts[c, 2], b1, b2)
-
+    ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, tri, time)
+    return (b0 * ax + b1 * bx + b2 * cx,
+            b0 * ay + b1 * by + b2 * cy,
+            b0 * az + b1 * bz + b2 * cz, b1, b2)
 
 
 @device
@@ -281,22 +281,22 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_to
 
 
 @device
-def emission_weight(tri_light, emit_pmf, tri_area, p, t_hit, cos_o_geo, flags, mis_pdf,
+def emission_weight(tri_light, emit_pmf, area, p, t_hit, cos_o_geo, flags, mis_pdf,
                     emit_pmf_scale):
-    """MIS weight of emission found by a BSDF ray on emissive triangle p."""
+    """MIS weight of emission found by a BSDF ray on emissive triangle p (of that ``area``)."""
     if flags & PF_MIS_SKIP:
         return 1.0
     j = tri_light[p]
     if j < 0:
         return 1.0
-    light_pdf = emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (tri_area[p] * cos_o_geo)
+    light_pdf = emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (area * cos_o_geo)
     return power_heuristic(mis_pdf, light_pdf)
 
 
 @device
-def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, mat_emission,
-                 idx, pmf, hx, hy, hz, bounce, u1, u2):
-    """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h.
+def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2, time):
+    """Sample light ``idx`` (a lamp, or NL + j for emissive triangle j) from point h,
+    emissive triangles as they are at ``time``.
 
     ``pmf`` is the probability with which the caller chose this light.
     Returns the direction and distance to the light point,
@@ -305,6 +305,7 @@ def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, 
     emitter's unit normal (zero for lamps) for offsetting the shadow ray's end,
     as a :class:`LightSample`.  All-zero radiance means no contribution.
     """
+    lamps = sc.lamps
     n_lamps = lamps.shape[0]
     if idx < n_lamps:
         lflags = int(lamps[idx, L_FLAGS])
@@ -322,20 +323,21 @@ def sample_light(lamps, emit_tri, verts, tris, tri_normal, tri_area, mat_index, 
         return LightSample(wix, wiy, wiz, dist, lr, lg, lb, pdf_l, use_mis,
                            (lflags & LF_CAST_SHADOW) != 0, nee_exclude(lflags), 0.0, 0.0, 0.0,
                            -1, 0.0, 0.0)
-    tri = np.int64(emit_tri[idx - n_lamps])
-    qx, qy, qz, b1, b2 = sample_triangle_point(verts, tris, tri, u1, u2)
+    tri = np.int64(sc.emit_tri[idx - n_lamps])
+    qx, qy, qz, b1, b2 = sample_triangle_point(sc, tri, u1, u2, time)
     lx, ly, lz = qx - hx, qy - hy, qz - hz
     d2 = lx * lx + ly * ly + lz * lz
     dist = math.sqrt(d2)
     if dist <= 0.0:
         return _no_light()
     wix, wiy, wiz = lx / dist, ly / dist, lz / dist
-    lnx, lny, lnz = tri_normal[tri, 0], tri_normal[tri, 1], tri_normal[tri, 2]
+    lnx, lny, lnz, area = prim_frame(sc, tri, time)
     cos_l = abs(lnx * wix + lny * wiy + lnz * wiz)
     if cos_l <= 0.0:
         return _no_light()
-    pdf_l = pmf * d2 / (tri_area[tri] * cos_l)
-    em = mat_index[tri]
-    return LightSample(wix, wiy, wiz, dist, mat_emission[em, 0] / pdf_l,
-                       mat_emission[em, 1] / pdf_l, mat_emission[em, 2] / pdf_l,
+    pdf_l = pmf * d2 / (area * cos_l)
+    em = sc.mat_index[tri]
+    emission = sc.mat_emission
+    return LightSample(wix, wiy, wiz, dist, emission[em, 0] / pdf_l,
+                       emission[em, 1] / pdf_l, emission[em, 2] / pdf_l,
                        pdf_l, True, True, 0, lnx, lny, lnz, tri, b1, b2)

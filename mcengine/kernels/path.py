@@ -145,14 +145,14 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
         if p >= 0 and p == st.self_prim[i]:
             stats[ST_SELF_HITS] += 1
-            s = past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz)
+            s = past_self_hit(sc, p, ox, oy, oz, dx, dy, dz, st.time[i])
             set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
                     ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, st.ray_tmax[i] - s)
             st.alive[i] = 1
             continue
         flags = st.flags[i]
         mis_pdf = st.mis_pdf[i]
-        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i])
+        t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i], st.time[i])
         direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
         # Light-picking probabilities at the vertex this ray left, for MIS.
         mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
@@ -191,7 +191,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             continue
         if sc.tri_area[p] <= 0.0:
             continue   # degenerate triangle: Embree should not report it; drop the path
-        sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+        sp = surface_point(sc, p, b1, b2, dx, dy, dz, st.time[i])
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
@@ -215,7 +215,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             if light_passes:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
-                               ray_length, sp.cos_o, flags, mis_pdf,
+                               ray_length, sp, flags, mis_pdf,
                                pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
@@ -471,6 +471,7 @@ def _move(st, i, m):
     st.flags[m] = st.flags[i]
     st.mis_pdf[m] = st.mis_pdf[i]
     st.self_prim[m] = st.self_prim[i]
+    st.time[m] = st.time[i]
     st.t32[m] = st.t32[i]
 
 
@@ -503,7 +504,7 @@ def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats,
         if not first:
             stats[ST_BOUNCE_RAYS] += n
         first = False
-        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n])
+        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n], st.time[:n])
         n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp)
         occluded = trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats)
         n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, pb, fp)

@@ -42,7 +42,7 @@ SAMPLER_SOBOL = 1         # Owen-scrambled, shuffled Sobol points per pixel (``s
 # different sets are independent; the independent sampler draws number k of
 # set s as dimension 4 s + k.
 SET_FILTER = 0           # 2: pixel filter x, y
-SET_LENS_TIME = 1        # 3: lens u, v and shutter time (reserved)
+SET_LENS_TIME = 1        # 3: lens u, v and shutter time
 SETS_PER_BOUNCE = 16
 SET_TERMINATE = 0        # 1: Russian roulette
 SET_LIGHT = 1            # 4: point on the light u, v; which light; which emissive triangle

@@ -164,6 +164,7 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
     sq.t32[n_shadow] = tmax
     sq.contrib[n_shadow, 0], sq.contrib[n_shadow, 1], sq.contrib[n_shadow, 2] = cr, cg, cb
     sq.path[n_shadow] = owner
+    sq.time[n_shadow] = sp.time
     sq.target[n_shadow, 0], sq.target[n_shadow, 1], sq.target[n_shadow, 2] = ex, ey, ez
     sq.transparent[n_shadow] = transparent_left
     sq.alive[n_shadow] = 1
@@ -306,14 +307,14 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
 
 
 @device
-def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths):
-    """Radiance emitted by triangle ``tri`` at barycentrics (b1, b2) towards a ray of
-    direction d and length dist that reaches it there (a light sample of a material whose
-    emission varies over the surface: its shader runs there, without closures, as Cycles
-    evaluates a light sample: path flag "emission", the bounce counts ``depths`` of the
-    path sampling it)."""
+def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths, time):
+    """Radiance emitted by triangle ``tri`` (as it is at ``time``) at barycentrics (b1, b2)
+    towards a ray of direction d and length dist that reaches it there (a light sample of a
+    material whose emission varies over the surface: its shader runs there, without closures,
+    as Cycles evaluates a light sample: path flag "emission", the bounce counts ``depths`` of
+    the path sampling it)."""
     m = sc.mat_index[tri]
-    sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, tri, b1, b2, dx, dy, dz)
+    sp = surface_point(sc, tri, b1, b2, dx, dy, dz, time)
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
                       sc.tex.tri_object[tri], PF_EMISSION, dist, depths, 0.0)
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
@@ -335,7 +336,7 @@ def emission_estimates(sc, scratch, tris, out):
             b1, b2 = points[k]
             er, eg, eb = emission_at(sc, scratch, t, b1, b2, -sc.tri_normal[t, 0],
                                      -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0,
-                                     (0, 0, 0, 0, 0))
+                                     (0, 0, 0, 0, 0), 0.5)
             r += er
             g += eg
             b += eb
@@ -343,11 +344,11 @@ def emission_estimates(sc, scratch, tris, out):
 
 
 @device
-def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, cos_o, flags, mis_pdf,
+def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, sp, flags, mis_pdf,
                        pmf_mode, mpx, mpy, mpz, mis_total, direct, er, eg, eb):
-    """Add emission (er, eg, eb) of triangle p seen by the ray, MIS-weighted."""
+    """Add emission (er, eg, eb) of triangle p, seen by the ray at ``sp``, MIS-weighted."""
     scale = emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total)
-    w = emission_weight(sc.tri_light, sc.emit_pmf, sc.tri_area, p, t_hit, cos_o, flags,
+    w = emission_weight(sc.tri_light, sc.emit_pmf, sp.area, p, t_hit, sp.cos_o, flags,
                         mis_pdf, scale)
     add_light(out, row, beta[i, 0] * er * w, beta[i, 1] * eg * w, beta[i, 2] * eb * w, direct,
               fcfg, stats)
@@ -390,15 +391,13 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     if idx == sc.lamps.shape[0] + sc.emit_tri.shape[0]:
         ls = world_light_sample(sc, cfg, scratch, pmf, u1, u2)
     else:
-        ls = sample_light(sc.lamps, sc.emit_tri, sc.verts, sc.tris, sc.tri_normal, sc.tri_area,
-                          sc.mat_index, sc.mat_emission, idx, pmf, sp.hx, sp.hy, sp.hz, bounce,
-                          u1, u2)
+        ls = sample_light(sc, idx, pmf, sp.hx, sp.hy, sp.hz, bounce, u1, u2, sp.time)
     scratch.light[0], scratch.light[1], scratch.light[2] = ls.wix, ls.wiy, ls.wiz
     scratch.light[3] = ls.exclude
     lr, lg, lb = ls.lr, ls.lg, ls.lb
     if ls.tri >= 0 and (sc.mat_flags[sc.mat_index[ls.tri]] & MF_EMISSION_VARIES):
         er, eg, eb = emission_at(sc, scratch, ls.tri, ls.b1, ls.b2, ls.wix, ls.wiy, ls.wiz, ls.dist,
-                                 depths)
+                                 depths, sp.time)
         lr, lg, lb = er / ls.pdf, eg / ls.pdf, eb / ls.pdf
     if lr == 0.0 and lg == 0.0 and lb == 0.0:   # (lights may be negative)
         return n_shadow

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ..jit import kernel
-from .intersect import SHADOW_SHORTEN, intersect_prim, offset_scale
+from .intersect import SHADOW_SHORTEN, intersect_triangle, offset_scale, prim_corners
 from .shading import shade_point
 from .state import CFG_MAX_TRANSPARENT, CFG_TRANSPARENT_SHADOWS, MF_TRANSPARENT, PF_SHADOW, ST_SHADOW_RAYS
 from .surface import surface_point
@@ -36,9 +36,11 @@ def trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats):
         return np.zeros(0, np.bool_)
     stats[ST_SHADOW_RAYS] += n_shadow
     if not cfg[CFG_TRANSPARENT_SHADOWS]:
-        return accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
+        return accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow],
+                              sq.time[:n_shadow])
     for _ in range(int(cfg[CFG_MAX_TRANSPARENT]) + 2):
-        prim = accel.closest(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow])
+        prim = accel.closest(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow],
+                             sq.time[:n_shadow])
         if advance_shadows(n_shadow, prim, sq, sc, cfg, scratch) == 0:
             break
     return sq.alive[:n_shadow] != SHADOW_ARRIVED
@@ -68,10 +70,11 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
             continue
         ox, oy, oz = sq.o32[s, 0], sq.o32[s, 1], sq.o32[s, 2]
         dx, dy, dz = sq.d32[s, 0], sq.d32[s, 1], sq.d32[s, 2]
-        t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, sc.verts, sc.tris, p)
+        ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, p, sq.time[s])
+        t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz)
         if not math.isfinite(t):
             t = 0.0
-        sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+        sp = surface_point(sc, p, b1, b2, dx, dy, dz, sq.time[s])
         # Light Path sees a shadow ray from the shading point, with the path's bounces and
         # the transparent surfaces passed so far (Cycles' shadow path state).
         dep = sq.depths[s]

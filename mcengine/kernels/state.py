@@ -37,6 +37,7 @@ PathState = namedtuple("PathState", [
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
     "dp",            # (B,) f64      ray differential: footprint at mis_p (Cycles' compact ray dP)
     "dd",            # (B,) f64      its growth per unit length (the camera's compact dD)
+    "time",          # (B,) f64      time of the path's camera sample, in [0, 1] over the shutter
     "alive",         # (B,) uint8    still tracing after this bounce
     "o32",           # (B, 3) f32    Embree input: origins
     "d32",           # (B, 3) f32    Embree input: directions
@@ -47,6 +48,7 @@ ShadowQueue = namedtuple("ShadowQueue", [
     "o32", "d32", "t32",   # Embree input
     "contrib",             # (B, 3) f64  radiance to add if unoccluded
     "path",                # (B,) int32  path the contribution belongs to
+    "time",                # (B,) f64    the path's time over the shutter
     "target",              # (B, 3) f64  end point of the ray (transparent shadows re-aim at it)
     "transparent",         # (B,) int32  transparent bounces the path may still make
     "alive",               # (B,) uint8  still being traced (transparent shadows)
@@ -88,6 +90,7 @@ SceneData = namedtuple("SceneData", [
     "camera",        # (CAMERA_PARAMS,) f64
     "filter_table",  # (FILTER_TABLE_SIZE,) f64
     "tex",           # svm.TextureData: attributes, objects, images for the shader nodes
+    "motion",        # kernels.motion.MotionData: the objects that move during the shutter
     "bg_marginal",   # (H + 1,) f64   the world's importance map: CDF over its rows
     "bg_conditional",  # (H, W + 1) f64  CDF over the columns of each row (kernels.background)
 ])
@@ -176,7 +179,7 @@ def alloc_path_state(n: int) -> PathState:
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
         mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
-        dp=np.zeros(n), dd=np.zeros(n), alive=np.zeros(n, np.uint8),
+        dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
 
@@ -184,7 +187,7 @@ def alloc_path_state(n: int) -> PathState:
 def alloc_shadow_queue(n: int) -> ShadowQueue:
     return ShadowQueue(o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
                        t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
-                       path=np.zeros(n, np.int32), target=np.zeros((n, 3)),
+                       path=np.zeros(n, np.int32), time=np.zeros(n), target=np.zeros((n, 3)),
                        transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
                        depths=np.zeros((n, 5), np.int32), travelled=np.zeros(n))
 

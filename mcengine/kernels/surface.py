@@ -1,9 +1,11 @@
 """The shading point: where a ray hit, the normals there, and the local frame.
 
 Embree reports only which triangle a ray hit; the hit distance and
-barycentrics are recomputed here in float64.  All BSDFs are two-sided, so the
-normals are turned towards the incoming ray and ``backfacing`` remembers which
-side was hit (it inverts the index of refraction).
+barycentrics are recomputed here in float64, from the triangle as it is at
+the path's time (``intersect.prim_corners``: moving objects move).  All BSDFs
+are two-sided, so the normals are turned towards the incoming ray and
+``backfacing`` remembers which side was hit (it inverts the index of
+refraction).
 """
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ import math
 from collections import namedtuple
 
 from ..jit import device
-from .intersect import intersect_prim, offset_scale
+from .intersect import intersect_triangle, offset_scale, prim_corners, prim_frame, prim_normals
 from .sampling import orthonormal_basis
 
 SurfacePoint = namedtuple("SurfacePoint", [
@@ -20,6 +22,8 @@ SurfacePoint = namedtuple("SurfacePoint", [
     "nsx", "nsy", "nsz",     # unit shading normal (interpolated), on the same side
     "cos_o",                 # cosine between the geometric normal and the way back (> 0)
     "backfacing",            # the ray came from the inside of the surface
+    "area",                  # area of the triangle (at the path's time, for a moving one)
+    "time",                  # the path's time over the shutter (0.5 without motion blur)
 ])
 
 Frame = namedtuple("Frame", [
@@ -30,45 +34,48 @@ Frame = namedtuple("Frame", [
 
 
 @device
-def past_self_hit(verts, tris, p, ox, oy, oz, dx, dy, dz):
+def past_self_hit(sc, p, ox, oy, oz, dx, dy, dz, time):
     """Distance to move a ray that re-hit the triangle it left, to just past that hit.
 
     Triangles are flat, so a ray leaving one can only hit it again through
     rounding: the ray continues from just past that hit.
     """
-    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p)
+    ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, p, time)
+    t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz)
     if not math.isfinite(t) or t < 0.0:
         t = 0.0
     return t + offset_scale(ox + t * dx, oy + t * dy, oz + t * dz) * 4.0
 
 
 @device
-def hit_distance(verts, tris, p, ox, oy, oz, dx, dy, dz, tmax):
-    """(t, b1, b2) of the ray's hit on triangle p (t = tmax if p < 0)."""
+def hit_distance(sc, p, ox, oy, oz, dx, dy, dz, tmax, time):
+    """(t, b1, b2) of the ray's hit on triangle p at ``time`` (t = tmax if p < 0)."""
     if p < 0:
         return tmax, 0.0, 0.0
-    t, b1, b2 = intersect_prim(ox, oy, oz, dx, dy, dz, verts, tris, p)
+    ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, p, time)
+    t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz)
     return (t if (math.isfinite(t) and t > 0.0) else 0.0), b1, b2
 
 
-
 @device
-def surface_point(verts, tris, tri_normal, normals, p, b1, b2, dx, dy, dz):
+def surface_point(sc, p, b1, b2, dx, dy, dz, time):
     """Hit point, geometric and shading normals facing the ray, and the side hit.
 
-    Returns a :class:`SurfacePoint`.  All BSDFs are two-sided, so both normals are turned towards the incoming
+    Returns a :class:`SurfacePoint`, triangle p taken as it is at ``time``.  All
+    BSDFs are two-sided, so both normals are turned towards the incoming
     ray; ``backfacing`` records that the ray came from the inside (relative to
     the winding, or to the shading normals where they disagree with it).
     """
     b0 = 1.0 - b1 - b2
-    va, vb, vc = tris[p, 0], tris[p, 1], tris[p, 2]
-    hx = b0 * verts[va, 0] + b1 * verts[vb, 0] + b2 * verts[vc, 0]
-    hy = b0 * verts[va, 1] + b1 * verts[vb, 1] + b2 * verts[vc, 1]
-    hz = b0 * verts[va, 2] + b1 * verts[vb, 2] + b2 * verts[vc, 2]
-    ngx, ngy, ngz = tri_normal[p, 0], tri_normal[p, 1], tri_normal[p, 2]
-    nsx = b0 * normals[p, 0, 0] + b1 * normals[p, 1, 0] + b2 * normals[p, 2, 0]
-    nsy = b0 * normals[p, 0, 1] + b1 * normals[p, 1, 1] + b2 * normals[p, 2, 1]
-    nsz = b0 * normals[p, 0, 2] + b1 * normals[p, 1, 2] + b2 * normals[p, 2, 2]
+    ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, p, time)
+    hx = b0 * ax + b1 * bx + b2 * cx
+    hy = b0 * ay + b1 * by + b2 * cy
+    hz = b0 * az + b1 * bz + b2 * cz
+    ngx, ngy, ngz, area = prim_frame(sc, p, time)
+    n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z = prim_normals(sc, p, time)
+    nsx = b0 * n0x + b1 * n1x + b2 * n2x
+    nsy = b0 * n0y + b1 * n1y + b2 * n2y
+    nsz = b0 * n0z + b1 * n1z + b2 * n2z
     ln = math.sqrt(nsx * nsx + nsy * nsy + nsz * nsz)
     if ln > 0.0 and math.isfinite(ln):
         nsx, nsy, nsz = nsx / ln, nsy / ln, nsz / ln
@@ -84,7 +91,7 @@ def surface_point(verts, tris, tri_normal, normals, p, b1, b2, dx, dy, dz):
         ngx, ngy, ngz = -ngx, -ngy, -ngz
         nsx, nsy, nsz = -nsx, -nsy, -nsz
         cos_o_geo = -cos_o_geo
-    return SurfacePoint(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing)
+    return SurfacePoint(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing, area, time)
 
 
 @device

@@ -100,13 +100,11 @@ def test_animated_seed_is_hashed_with_the_frame(scene, fake_session, addon):
         assert addon.export.settings.hash_uint2(kx, ky) == _lookup3_hash_uint2(kx, ky)
 
 
-def test_unsupported_sampling_features_are_warned(scene, fake_session):
+def test_sampling_with_motion_blur_warns_nothing(scene, fake_session):
     scene.cycles.samples = 16
-    scene.render.use_motion_blur = True
+    scene.render.use_motion_blur = True        # supported: no warning
     warnings = export_scene(fake_session).warnings
-    assert warnings == [
-        "motion blur is enabled: not supported yet; rendering the frame without it",
-    ]
+    assert warnings == []
 
 
 def test_without_cycles_the_defaults_are_used_with_one_warning(scene, fake_session, addon):

@@ -36,3 +36,22 @@ def test_a_scene_without_triangles_has_a_bvh_too():
     assert hit.tolist() == [-1]
     assert accel_cache.accel_for(np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32))[1]
     accel_cache.clear()
+
+
+def test_moving_triangles_are_never_reused():
+    """The same triangles with an object moving during the shutter: the kept BVH (static)
+    would miss the motion, and a BVH with motion is not kept for a static render."""
+    from mcengine.kernels.motion import pack_motion
+    from mcengine.scene import Geometry, ObjectMotion
+    g = Geometry.from_triangles(VERTICES[TRIANGLES], object_names=["Box"])
+    shift = np.eye(4)
+    shift[0, 3] = 0.5
+    motion = pack_motion(g, [ObjectMotion(object=0, vertices=(0, 6),
+                                          matrices=np.stack([np.eye(4), np.eye(4), shift]))])
+    accel_cache.clear()
+    static, _ = accel_cache.accel_for(g.vertices, g.triangles)
+    moving, reused = accel_cache.accel_for(g.vertices, g.triangles, motion)
+    assert not reused and moving is not static
+    assert not accel_cache.accel_for(g.vertices, g.triangles, motion)[1]
+    assert not accel_cache.accel_for(g.vertices, g.triangles)[1]
+    accel_cache.clear()

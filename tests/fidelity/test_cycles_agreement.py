@@ -21,10 +21,10 @@ import json
 import numpy as np
 import pytest
 
-from mcengine.evaluation.comparison import POWER_BIAS, detectable_bias, suite_row
+from mcengine.evaluation.comparison import POWER_BIAS, build_comparison, detectable_bias, suite_row
 from mcengine.evaluation.output import write_comparison, write_suite
 
-from .conftest import SCENES
+from .conftest import SCENES, options_for
 
 # A frame POWER_BIAS (5 %) too bright must be found with 95 % probability: the
 # report's criterion for saying that the frame means agree.
@@ -39,7 +39,8 @@ def test_scenes_exist():
             # added for the fidelity suite: every light parameter, transforms, cameras
             "light_area_spread", "light_point_large", "light_spot_shapes", "light_sun_wide",
             "transforms", "instancing_modifiers", "camera_sensor_fit", "camera_portrait_wide",
-            "camera_ortho", "camera_dof", "camera_dof_ortho"} <= names
+            "camera_ortho", "camera_dof", "camera_dof_ortho",
+            "motion_transform", "motion_camera", "motion_deform"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
@@ -53,6 +54,26 @@ def test_scene_agrees_with_cycles(blend, renders):
     assert np.all(detectable_bias(a) <= POWER_BIAS), \
         f"a {100 * POWER_BIAS:.0f} % error would be missed: detectable {detectable_bias(a)}"
     assert result.verdict == "agree", a.summary() + " " + repr(a.differing_blocks()[:5])
+
+
+def _shutter_at(position):
+    def edit(scene):
+        scene.render.motion_blur_position = position
+    return edit
+
+
+@pytest.mark.parametrize("position", ["START", "END"])
+def test_motion_blur_agrees_at_every_shutter_position(renders, position):
+    """motion_transform (CENTER in the suite) with the shutter opening at the frame or
+    closing at it: both engines render the edited scene."""
+    edit = _shutter_at(position)
+    ours = renders.runs("motion_transform", "mcengine", position, edit)
+    cycles = renders.runs("motion_transform", "cycles", position, edit)
+    options = options_for("motion_transform", position)
+    result = build_comparison(f"motion_transform ({position})", ours, cycles, grid=options.grid,
+                              alpha=options.alpha)
+    assert np.all(detectable_bias(result.agreement) <= POWER_BIAS)
+    assert result.verdict == "agree", result.agreement.summary()
 
 
 def _brighter(scene):

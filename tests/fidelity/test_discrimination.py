@@ -109,6 +109,35 @@ def test_missing_bump_is_caught(renders, what, edit):
     assert result.agreement.differing_blocks()
 
 
+def _no_motion_blur(scene):
+    scene.render.use_motion_blur = False
+
+
+def _no_deformation_blur(scene):
+    for ob in scene.objects:
+        ob.cycles.use_deform_motion = False
+
+
+def _shutter_at(position):
+    def edit(scene):
+        scene.render.motion_blur_position = position
+    return edit
+
+
+@pytest.mark.parametrize("name,what,edit", [
+    ("motion_transform", "shutter closed", _no_motion_blur),
+    ("motion_transform", "shutter opening at the frame", _shutter_at("START")),
+    ("motion_camera", "camera still", _no_motion_blur),
+    ("motion_deform", "no deformation blur", _no_deformation_blur),
+])
+def test_motion_blur_errors_are_caught(renders, name, what, edit):
+    """Sharp objects, a shutter in the wrong place, a still camera or meshes blurred only by
+    their transforms: the blocks where things move differ."""
+    result = renders.compare(name, what, edit)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
 def test_cycles_agrees_with_itself_across_seeds(blend, renders):
     name = blend.stem

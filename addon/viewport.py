@@ -248,9 +248,9 @@ class ViewportRender:
 
 
 def _camera_key(camera) -> tuple:
-    """The camera as a hashable value (its matrix as bytes)."""
-    fields = dict(camera.__dict__)
-    fields["matrix_world"] = np.asarray(camera.matrix_world, np.float64).tobytes()
+    """The camera as a hashable value (its arrays, the matrix and motion steps, as bytes)."""
+    fields = {name: (np.asarray(value, np.float64).tobytes() if name in ("matrix_world", "motion")
+                     else value) for name, value in camera.__dict__.items()}
     return tuple(sorted(fields.items()))
 
 

@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from ..jit import device, kernel
-from .camera import C_APERTURE
+from .camera import C_APERTURE, C_MOTION_STEPS, C_VIEW_POST, C_VIEW_PRE
 from .closures import bsdf_eval, bsdf_sample_closure
 from .closures.layout import (
     CL_ETA,
@@ -93,6 +93,8 @@ from .state import (
 from .surface import hit_distance, past_self_hit, surface_point
 
 _K_LIGHT_PATH = np.uint64(0x5851F42D4C957F2D)
+# The shutter time of every light path: light tracing is off where anything moves (``prepare``).
+_TIME = 0.5
 # Light path flags (PathState.flags of a light path).
 LP_CAUSTIC = 1          # xk scattered through a singular lobe: the path is light tracing's
 
@@ -115,6 +117,11 @@ def prepare(scene, sc, cfg, plan) -> tuple:
     if sc.camera[C_APERTURE] > 0.0:
         off.append("Path + Light Tracing renders as path tracing with depth of field (light "
                    "paths cannot be joined to a thin lens)")
+    cam = sc.camera
+    if len(sc.motion.slot_info) or cam[C_MOTION_STEPS] > 0 or \
+            (cam[C_VIEW_PRE], cam[C_VIEW_POST]) != (1.0, 1.0):
+        off.append("Path + Light Tracing renders as path tracing with motion blur (light "
+                   "paths have no shutter time yet)")
     if it.filter_glossy > 0:
         off.append("Path + Light Tracing renders as path tracing with Filter Glossy (blurred "
                    "lobes are no longer singular, so the two would count some paths twice)")
@@ -224,7 +231,7 @@ def adjoint_singular(cl, k, label, ngx, ngy, ngz, wix, wiy, wiz, wox, woy, woz):
 @device
 def _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t, flags):
     """Triangle p's closures at (b1, b2) for a viewer at -d (to ``scratch.cl``)."""
-    sp = surface_point(sc.verts, sc.tris, sc.tri_normal, sc.normals, p, b1, b2, dx, dy, dz)
+    sp = surface_point(sc, p, b1, b2, dx, dy, dz, _TIME)
     res = shade_point(sc, cfg, scratch, sp, sc.mat_index[p], p, b1, b2, dx, dy, dz, t, flags, True,
                       (0, 0, 0, 0, 0), 0.0)
     return sp, res
@@ -247,14 +254,14 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
         dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
         if p >= 0 and p == st.self_prim[i]:
             stats[ST_SELF_HITS] += 1
-            s = past_self_hit(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz)
+            s = past_self_hit(sc, p, ox, oy, oz, dx, dy, dz, _TIME)
             set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
                     ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, math.inf)
             continue
         st.alive[i] = 0
         if p < 0 or sc.tri_area[p] <= 0.0:
             continue
-        t_hit, b1, b2 = hit_distance(sc.verts, sc.tris, p, ox, oy, oz, dx, dy, dz, math.inf)
+        t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, math.inf, _TIME)
         sp, res = _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t_hit, 0)
         if res.n == 0:
             continue

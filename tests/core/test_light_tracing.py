@@ -24,7 +24,17 @@ from scipy import stats
 
 from mcengine.kernels.importance import filter_density
 from mcengine.kernels.sampling import filter_offset, filter_table
-from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
+from mcengine.scene import (
+    Camera,
+    Film,
+    Geometry,
+    Integrator,
+    Light,
+    Material,
+    MotionBlur,
+    SceneDescription,
+    World,
+)
 from mcengine.session import RenderSession
 
 from .scenes import grid_plane, look_down, rotation_x, translation, uv_sphere
@@ -175,6 +185,19 @@ def test_caustics_switches_off_render_as_path_tracing():
     image = session.run().image()
     scene.integrator.name = "path"
     assert np.array_equal(image, RenderSession(scene, threads=1).run().image())
+
+
+def test_motion_blur_renders_as_path_tracing_only_where_something_moves():
+    scene = glass_scene(samples=4, res=8)
+    scene.integrator.name = "light"
+    scene.motion_blur = MotionBlur()            # the shutter open, nothing moving
+    assert RenderSession(scene, threads=1).light_tables is not None
+    frame = scene.camera.matrix_world
+    scene.camera.motion = np.stack([translation(-0.1, 0.0, 0.0) @ frame, frame,
+                                    translation(0.1, 0.0, 0.0) @ frame])
+    session = RenderSession(scene, threads=1)
+    assert session.light_tables is None
+    assert any("motion blur" in w for w in session.warnings)
 
 
 @pytest.mark.parametrize("filter_type,width", [("BLACKMAN_HARRIS", 1.5), ("GAUSSIAN", 1.5), ("BOX", 1.0)])

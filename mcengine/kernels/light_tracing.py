@@ -89,6 +89,7 @@ from .state import (
     ST_BOUNCE_RAYS,
     ST_SELF_HITS,
     ST_SHADOW_RAYS,
+    move_path,
 )
 from .surface import hit_distance, past_self_hit, surface_point
 
@@ -403,23 +404,6 @@ def compact_light_paths(n, st):
         if not st.alive[i]:
             continue
         if m != i:
-            st.key[m] = st.key[i]
-            st.pixel[m] = st.pixel[i]
-            for c in range(3):
-                st.ray_o[m, c] = st.ray_o[i, c]
-                st.ray_d[m, c] = st.ray_d[i, c]
-                st.o32[m, c] = st.o32[i, c]
-                st.d32[m, c] = st.d32[i, c]
-                st.beta[m, c] = st.beta[i, c]
-            st.ray_tmax[m] = st.ray_tmax[i]
-            st.t32[m] = st.t32[i]
-            st.self_prim[m] = st.self_prim[i]
-            st.bounce[m] = st.bounce[i]
-            st.diffuse[m] = st.diffuse[i]
-            st.glossy[m] = st.glossy[i]
-            st.transmission[m] = st.transmission[i]
-            st.transparent[m] = st.transparent[i]
-            st.flags[m] = st.flags[i]
-            st.alive[m] = 1
+            move_path(st, i, m)
         m += 1
     return m

@@ -106,6 +106,7 @@ from .state import (
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
     ST_SELF_HITS,
+    move_path,
 )
 from .surface import hit_distance, past_self_hit, surface_point
 
@@ -423,7 +424,7 @@ def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, 
     for i in range(n):
         if st.alive[i]:
             if m != i:
-                _move(st, i, m)
+                move_path(st, i, m)
                 if move_passes:
                     for c in range(6):
                         pb.pw[m, c] = pb.pw[i, c]
@@ -447,32 +448,6 @@ def _splat(st, i, film_sum, film_sq, film_n):
     film_sq[pix, 1] += g * g
     film_sq[pix, 2] += b * b
     film_n[pix] += 1
-
-
-@device
-def _move(st, i, m):
-    st.key[m] = st.key[i]
-    st.pixel[m] = st.pixel[i]
-    for c in range(3):
-        st.ray_o[m, c] = st.ray_o[i, c]
-        st.ray_d[m, c] = st.ray_d[i, c]
-        st.beta[m, c] = st.beta[i, c]
-        st.radiance[m, c] = st.radiance[i, c]
-        st.o32[m, c] = st.o32[i, c]
-        st.d32[m, c] = st.d32[i, c]
-        st.mis_p[m, c] = st.mis_p[i, c]
-    st.ray_tmax[m] = st.ray_tmax[i]
-    st.transparency[m] = st.transparency[i]
-    st.bounce[m] = st.bounce[i]
-    st.diffuse[m] = st.diffuse[i]
-    st.glossy[m] = st.glossy[i]
-    st.transmission[m] = st.transmission[i]
-    st.transparent[m] = st.transparent[i]
-    st.flags[m] = st.flags[i]
-    st.mis_pdf[m] = st.mis_pdf[i]
-    st.self_prim[m] = st.self_prim[i]
-    st.time[m] = st.time[i]
-    st.t32[m] = st.t32[i]
 
 
 @kernel

@@ -12,6 +12,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..jit import device
 from .closures.layout import CL_STRIDE, MAX_CLOSURES
 
 # -- path state ----------------------------------------------------------------------
@@ -182,6 +183,38 @@ def alloc_path_state(n: int) -> PathState:
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
+
+
+@device
+def move_path(st, i, m):
+    """Move path i's state to slot m (compaction): every field but ``root``, which only the
+    classic integrators use and keep in their own order."""
+    st.key[m] = st.key[i]
+    st.pixel[m] = st.pixel[i]
+    for c in range(3):
+        st.ray_o[m, c] = st.ray_o[i, c]
+        st.ray_d[m, c] = st.ray_d[i, c]
+        st.beta[m, c] = st.beta[i, c]
+        st.radiance[m, c] = st.radiance[i, c]
+        st.mis_p[m, c] = st.mis_p[i, c]
+        st.o32[m, c] = st.o32[i, c]
+        st.d32[m, c] = st.d32[i, c]
+    st.ray_tmax[m] = st.ray_tmax[i]
+    st.transparency[m] = st.transparency[i]
+    st.bounce[m] = st.bounce[i]
+    st.diffuse[m] = st.diffuse[i]
+    st.glossy[m] = st.glossy[i]
+    st.transmission[m] = st.transmission[i]
+    st.transparent[m] = st.transparent[i]
+    st.flags[m] = st.flags[i]
+    st.mis_pdf[m] = st.mis_pdf[i]
+    st.min_pdf[m] = st.min_pdf[i]
+    st.self_prim[m] = st.self_prim[i]
+    st.dp[m] = st.dp[i]
+    st.dd[m] = st.dd[i]
+    st.time[m] = st.time[i]
+    st.alive[m] = st.alive[i]
+    st.t32[m] = st.t32[i]
 
 
 def alloc_shadow_queue(n: int) -> ShadowQueue:

@@ -25,7 +25,7 @@ from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
 from .kernels.motion import pack_motion
-from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, PassData
+from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, P_VECTOR, PassData
 from .kernels.sampling import SAMPLER_INDEPENDENT, filter_table
 from .kernels.shading import emission_estimates
 from .kernels.sobol import index_mask
@@ -74,7 +74,7 @@ from .kernels.svm import (
     OP_NODE,
     TextureData,
 )
-from .passes import kernel_data
+from .passes import kernel_data, motion_corners, world_to_raster
 from .scene import SceneDescription
 from .shaders import AttributeLayout, ShaderTable
 
@@ -313,5 +313,17 @@ def pack_passes(scene: SceneDescription, lay) -> PassData:
     mat_info = np.array([[m.pass_index, cryptomatte.name_id(m.name)] for m in scene.materials],
                         np.float32).reshape(-1, 2)
     cam = scene.camera
+    tri_motion = rasters = None
+    if P_VECTOR in lay:
+        motion = scene.motion_vectors
+        tri_motion = motion_corners(g, motion) if t else None
+        film = scene.film
+        frame = (film.width, film.height, (film.pixel_aspect_x, film.pixel_aspect_y))
+        now = np.asarray(cam.matrix_world, float)
+        moved = motion.camera if motion is not None and motion.camera is not None else (now, now)
+        scale = motion.view_scale if motion is not None else (1.0, 1.0)
+        rasters = [world_to_raster(now, cam, *frame)] + [
+            world_to_raster(np.asarray(m, float), cam, *frame, view_scale=k)
+            for m, k in zip(moved, scale)]
     return kernel_data(lay, scene.passes, np.asarray(cam.matrix_world, float), cam.type == "ORTHO",
-                       tri_uv, tri_object, mat_info)
+                       tri_uv, tri_object, mat_info, tri_motion, rasters)

@@ -14,6 +14,10 @@ its image is read from the per-pixel sums (Cycles' kernel/film/read.h):
             counts cancel), times the film exposure: Combined = Σ (direct +
             indirect) × colour + emission + environment
 ``exposed`` the mean times the film exposure (emission, environment)
+``motion``  the sum over the samples that hit a surface divided by their number
+            (Vector: the kernels sum a weight of 1 per such sample); 0 where none
+            did, and everywhere when motion blur is on (Cycles writes the pass
+            only without motion blur)
 ``zero``    not computed by MC Engine (written as 0, with a warning)
 
 :class:`RenderPasses` holds a render's pass settings; :func:`layout` assigns
@@ -33,8 +37,8 @@ from .kernels import passes as kp
 
 __all__ = ["PassInfo", "PASSES", "CRYPTO_TYPES", "DENOISING_PASSES", "NOISY_IMAGE", "RenderPasses",
            "Layout", "layout", "read", "MIST_FALLOFFS", "UNSUPPORTED", "SPLIT_DIFFERS",
-           "cryptomatte_metadata",
-           "kernel_data", "world_to_camera", "bytes_per_pixel"]
+           "cryptomatte_metadata", "kernel_data", "world_to_camera", "world_to_raster",
+           "motion_corners", "bytes_per_pixel"]
 
 
 class PassInfo(NamedTuple):
@@ -52,7 +56,7 @@ PASSES = (
     PassInfo("Mist", "Z", "VALUE", "use_pass_mist", kp.P_MIST, "mist"),
     PassInfo("Position", "XYZ", "VECTOR", "use_pass_position", kp.P_POSITION, "first"),
     PassInfo("Normal", "XYZ", "VECTOR", "use_pass_normal", kp.P_NORMAL, "mean"),
-    PassInfo("Vector", "XYZW", "VECTOR", "use_pass_vector", kp.P_VECTOR, "zero"),
+    PassInfo("Vector", "XYZW", "VECTOR", "use_pass_vector", kp.P_VECTOR, "motion"),
     PassInfo("UV", "UVA", "VECTOR", "use_pass_uv", kp.P_UV, "mean"),
     PassInfo("Object Index", "X", "VALUE", "use_pass_object_index", kp.P_OBJECT_ID, "first"),
     PassInfo("Material Index", "X", "VALUE", "use_pass_material_index", kp.P_MATERIAL_ID, "first"),
@@ -98,7 +102,6 @@ MIST_FALLOFFS = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
 
 # Passes MC Engine lists but does not compute, and what it writes instead.
 UNSUPPORTED = {
-    "Vector": "motion vectors are not computed (written as 0)",
     "Ambient Occlusion": "ambient occlusion is not computed (written as 0)",
 }
 
@@ -120,7 +123,8 @@ class RenderPasses:
     ``denoising_data`` adds Cycles' Denoising Normal, Albedo and Depth.
     Mist settings are the world's; ``alpha_threshold`` is the view layer's
     (normal and UV come from the first surface at least that opaque).
-    ``view_layer`` names the Cryptomatte metadata layers.
+    ``view_layer`` names the Cryptomatte metadata layers.  With ``motion_blur`` on, the
+    Vector pass is left at 0, as Cycles leaves it.
     """
 
     enabled: tuple = ()
@@ -132,6 +136,7 @@ class RenderPasses:
     mist_falloff: str = "QUADRATIC"
     alpha_threshold: float = 0.5
     view_layer: str = "ViewLayer"
+    motion_blur: bool = False
 
     def names(self) -> list[str]:
         """Every pass of the render result besides Combined, in Blender's order."""
@@ -172,7 +177,7 @@ class Layout:
         return slot in self.columns
 
 
-_WIDTH = {kp.P_DEPTH: 1, kp.P_MIST: 1, kp.P_OBJECT_ID: 1, kp.P_MATERIAL_ID: 1, kp.P_VECTOR: 4,
+_WIDTH = {kp.P_DEPTH: 1, kp.P_MIST: 1, kp.P_OBJECT_ID: 1, kp.P_MATERIAL_ID: 1, kp.P_VECTOR: 5,
           kp.P_DENOISING_DEPTH: 1}
 
 
@@ -181,7 +186,8 @@ def layout(passes: RenderPasses, denoising_guides: tuple = ()) -> Layout:
     by, and the guide passes ``denoising_guides``: slots the denoiser reads)."""
     slots = []
     for p in PASSES:
-        if p.name in passes.enabled and p.readout != "zero":
+        if p.name in passes.enabled and p.readout != "zero" and not (
+                p.slot == kp.P_VECTOR and passes.motion_blur):
             slots.append(p.slot)
             if p.divide >= 0:
                 slots.append(p.divide)
@@ -217,9 +223,13 @@ def read(name: str, sums: np.ndarray, count: np.ndarray, lay: Layout, exposure: 
     info = BY_NAME.get(name) or next(p for p in DENOISING_PASSES if p.name == name)
     width = len(info.channels)
     n = count.shape[0]
-    if info.readout == "zero":
+    if info.readout == "zero" or info.slot not in lay:
         return np.zeros((n, width), np.float32)
     col = lay.columns[info.slot]
+    if info.readout == "motion":
+        weight = sums[:, col + 4:col + 5]
+        return np.where(weight > 0.0, sums[:, col:col + 4] / np.where(weight > 0.0, weight, 1.0),
+                        0.0).astype(np.float32)
     values = sums[:, col:col + min(width, 3)]
     if info.readout == "first":
         out = values.copy()
@@ -295,13 +305,15 @@ def cryptomatte_metadata(passes: RenderPasses, objects, materials, used_material
 
 
 def kernel_data(lay: Layout, passes: RenderPasses, camera_to_world: np.ndarray, ortho: bool,
-                tri_uv, tri_object, mat_info) -> kp.PassData:
-    """The kernels' :class:`kernels.passes.PassData` for a layout."""
+                tri_uv, tri_object, mat_info, tri_motion=None, rasters=None) -> kp.PassData:
+    """The kernels' :class:`kernels.passes.PassData` for a layout; ``tri_motion`` and
+    ``rasters`` (world to raster now, at the previous and the next frame) for the Vector
+    pass."""
     cfg = np.full(kp.PC_SIZE, -1, np.int64)
     for slot, col in lay.columns.items():
         cfg[slot] = col
-    data_slots = (kp.P_DEPTH, kp.P_MIST, kp.P_POSITION, kp.P_NORMAL, kp.P_UV, kp.P_OBJECT_ID,
-                  kp.P_MATERIAL_ID, kp.P_DIFFUSE_COLOR, kp.P_GLOSSY_COLOR, kp.P_TRANSMISSION_COLOR,
+    data_slots = (kp.P_DEPTH, kp.P_MIST, kp.P_POSITION, kp.P_NORMAL, kp.P_UV, kp.P_VECTOR,
+                  kp.P_OBJECT_ID, kp.P_MATERIAL_ID, kp.P_DIFFUSE_COLOR, kp.P_GLOSSY_COLOR, kp.P_TRANSMISSION_COLOR,
                   kp.P_CRYPTO_OBJECT, kp.P_CRYPTO_MATERIAL, kp.P_CRYPTO_ASSET)
     light_slots = (kp.P_DIFFUSE_DIRECT, kp.P_DIFFUSE_INDIRECT, kp.P_GLOSSY_DIRECT,
                    kp.P_GLOSSY_INDIRECT, kp.P_TRANSMISSION_DIRECT, kp.P_TRANSMISSION_INDIRECT,
@@ -320,8 +332,12 @@ def kernel_data(lay: Layout, passes: RenderPasses, camera_to_world: np.ndarray, 
     fcfg[kp.PV_ALPHA_THRESHOLD] = passes.alpha_threshold
     fcfg[kp.PV_ORTHO] = 1.0 if ortho else 0.0
     fcfg[kp.PV_CAMERA:kp.PV_CAMERA + 12] = world_to_camera(camera_to_world).reshape(-1)
+    if rasters is not None:
+        fcfg[kp.PV_RASTER:kp.PV_RASTER + 36] = np.asarray(rasters, np.float64).reshape(-1)
+    if tri_motion is None:
+        tri_motion = np.zeros((1, 2, 3, 3), np.float32)
     return kp.PassData(cfg=cfg, fcfg=fcfg, tri_uv=tri_uv, tri_object=tri_object,
-                       mat_info=mat_info)
+                       mat_info=mat_info, tri_motion=tri_motion)
 
 
 def world_to_camera(camera_to_world: np.ndarray) -> np.ndarray:
@@ -332,3 +348,44 @@ def world_to_camera(camera_to_world: np.ndarray) -> np.ndarray:
     axes = axes * np.array([1.0, 1.0, -1.0])
     rot = axes.T
     return np.concatenate([rot, (-rot @ m[:3, 3])[:, None]], axis=1)
+
+
+def world_to_raster(camera_to_world: np.ndarray, cam, width: int, height: int,
+                    pixel_aspect=(1.0, 1.0), view_scale: float = 1.0) -> np.ndarray:
+    """(3, 4) rows x, y, w of the projection of world points to raster positions (pixels,
+    x right, y up from the frame's bottom-left corner: Cycles' raster space), for the camera
+    ``cam`` (a ``scene.Camera``) placed at ``camera_to_world``.  ``view_scale`` scales a
+    perspective camera's view plane (a focal length other than the frame's, as
+    ``Camera.view_scale_motion``)."""
+    from .kernels.camera import view_plane
+    half_w, half_h, shift_x, shift_y = view_plane(cam, width, height, pixel_aspect)
+    to_cam = world_to_camera(camera_to_world)
+    sx, sy = width / (2.0 * half_w), height / (2.0 * half_h)
+    if cam.type == "ORTHO":
+        depth = np.array([0.0, 0.0, 0.0, 1.0])
+        view = 1.0
+    else:
+        depth = to_cam[2]
+        view = 1.0 / view_scale
+    return np.stack([sx * (view * to_cam[0] + (half_w - shift_x) * depth),
+                     sy * (view * to_cam[1] + (half_h - shift_y) * depth), depth])
+
+
+def motion_corners(geometry, motion) -> np.ndarray:
+    """(T, 2, 3, 3) float32 world corners of every triangle at the previous and the next
+    frame, from a ``scene.MotionVectors`` (None: nothing moves).  An object's vertices there
+    are ``M(t) M(frame)^-1`` applied to its positions at t (deformed) or at the frame."""
+    vertices = np.asarray(geometry.vertices, np.float64)
+    steps = [vertices.copy(), vertices.copy()]
+    for om in (motion.objects if motion is not None else ()):
+        first, count = om.vertices
+        for k, step in enumerate((0, -1)):
+            v = vertices[first:first + count] if om.positions is None else \
+                np.asarray(om.positions[step], np.float64)
+            if len(om.matrices):
+                m = np.asarray(om.matrices, np.float64)
+                a = m[step] @ np.linalg.inv(m[len(m) // 2])
+                v = v @ a[:3, :3].T + a[:3, 3]
+            steps[k][first:first + count] = v
+    tris = np.asarray(geometry.triangles)
+    return np.ascontiguousarray(np.stack([steps[0][tris], steps[1][tris]], axis=1), np.float32)

@@ -453,6 +453,22 @@ class MotionBlur:
     objects: list = field(default_factory=list)
 
 
+@dataclass
+class MotionVectors:
+    """The scene at the previous and the next frame, for the Vector pass (motion blur off).
+
+    ``objects`` are :class:`ObjectMotion` s of three steps (previous frame, frame, next
+    frame) for the objects that move or deform; ``camera`` the camera's matrices (metres,
+    without scale) at the previous and the next frame (None: it stays); ``view_scale`` a
+    perspective camera's view plane there relative to the frame's, as
+    ``Camera.view_scale_motion``.
+    """
+
+    objects: list = field(default_factory=list)
+    camera: np.ndarray | None = None
+    view_scale: tuple = (1.0, 1.0)
+
+
 WORLD_SAMPLING = ("NONE", "AUTOMATIC", "MANUAL")
 
 
@@ -565,6 +581,7 @@ class SceneDescription:
     passes: RenderPasses = field(default_factory=RenderPasses)
     denoising: Denoising = field(default_factory=Denoising)
     motion_blur: MotionBlur | None = None     # None: the shutter is closed, every ray at time 0.5
+    motion_vectors: MotionVectors | None = None   # Vector pass: None when nothing moves
     warnings: list = field(default_factory=list)
     images: dict = field(default_factory=dict)       # name -> Image
 
@@ -679,6 +696,22 @@ class SceneDescription:
                           lo=0.0, hi=1.0)
             for om in mb.objects:
                 _check_object_motion(om, self.geometry)
+        if self.motion_vectors is not None:
+            mv = self.motion_vectors
+            for om in mv.objects:
+                _check_object_motion(om, self.geometry)
+                if om.steps != 3:
+                    raise SceneError(f"motion vectors: an object's motion needs 3 steps (previous "
+                                     f"frame, frame, next frame), got {om.steps}")
+            if mv.camera is not None:
+                if np.shape(mv.camera) != (2, 4, 4):
+                    raise SceneError(f"motion vectors: camera must be 2 4x4 matrices, got "
+                                     f"{np.shape(mv.camera)}")
+                for m in mv.camera:
+                    _check_matrix("motion vectors camera", m, axes=True)
+            _check_vector("motion vectors", "view_scale", mv.view_scale, 2)
+            if min(mv.view_scale) <= 0.0:
+                raise SceneError(f"motion vectors: view_scale must be positive, got {mv.view_scale}")
         if c.sensor_fit not in ("AUTO", "HORIZONTAL", "VERTICAL"):
             raise SceneError(f"camera: unknown sensor_fit {c.sensor_fit!r} (AUTO, HORIZONTAL, VERTICAL)")
         _check_number("camera", "aperture_size", c.aperture_size, lo=0.0)

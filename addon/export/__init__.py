@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mcengine.kernels.camera import view_plane
-from mcengine.scene import SceneDescription, SceneError
+from mcengine.scene import MotionVectors, SceneDescription, SceneError
 
 __all__ = ["ExportError", "ExportContext", "ExportResult", "PARTS", "export"]
 
@@ -112,6 +112,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
             scene.frame_set(frame, subframe=subframe)
     ctx = ExportContext(scene)
     shutter = motion.shutter(scene, depsgraph.view_layer) if camera is None else None
+    vectors = motion.vector_shutter(scene, depsgraph.view_layer) if camera is None else None
     if shutter is not None and shutter.position != "CENTER":
         # Cycles takes the scene (lamps, materials, what does not move) at the shutter's middle.
         frame_set(int(shutter.middle // 1), shutter.middle % 1)
@@ -124,7 +125,9 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
             parts.add("objects")
     layout = None
     if "objects" in parts:
-        geometry, material_list, walked_lights, layout = _walk(ctx, depsgraph, shutter=shutter)
+        geometry, material_list, walked_lights, layout = _walk(ctx, depsgraph,
+                                                               shutter=shutter or vectors,
+                                                               vectors=vectors is not None)
     else:
         geometry, walked_lights = old.geometry, None
         if "materials" not in parts:
@@ -153,14 +156,19 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     desc.images = _images_used(desc, {**(old.images if old is not None else {}), **ctx.images})
     if shutter is not None and layout is not None:
         desc.motion_blur = _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam)
+    desc.passes.motion_blur = shutter is not None
+    if vectors is not None and layout is not None and "Vector" in desc.passes.enabled:
+        desc.motion_vectors = _export_motion_vectors(ctx, depsgraph, frame_set, vectors, layout,
+                                                     cam)
     desc.warnings = list(ctx.warnings)
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
 
-def _walk(ctx, depsgraph, meshes: bool = True, shutter=None):
+def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = False):
     """One pass over the instances: (geometry, materials, lights, layout); geometry,
     materials and layout (``MeshCollector.layout``, tagged with each instance's motion
-    settings when the ``shutter`` is open) are None without ``meshes``."""
+    settings when the ``shutter`` is open, with the Vector pass's steps for ``vectors``)
+    are None without ``meshes``."""
     from . import lights, materials, mesh, motion
 
     table = materials.MaterialTable(ctx)
@@ -179,9 +187,10 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None):
                 tag = None
                 if shutter is not None:
                     parent = inst.parent if inst.is_instance else None
-                    steps = motion.motion_steps(ob.original, parent.original if parent else None)
+                    steps = motion.VECTOR_STEPS if vectors else motion.motion_steps(
+                        ob.original, parent.original if parent else None)
                     tag = (motion.instance_key(inst), steps,
-                           steps > 0 and motion.deforms(ob, parent, depsgraph.scene))
+                           steps > 0 and motion.deforms(ob, parent, depsgraph.scene, vectors))
                 collector.add(inst, _instance_name(inst), tag)
         except Exception as exc:  # one bad object must not abort the render
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
@@ -212,8 +221,10 @@ def _images_used(desc: SceneDescription, images: dict) -> dict:
     return {name: im for name, im in images.items() if name in names}
 
 
-def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
-    """The scene's MotionBlur; sets the camera's motion (the frame is set back afterwards)."""
+def _sample_layout(ctx, depsgraph, frame_set, shutter, layout):
+    """The layout's objects and the camera sampled over the ``shutter`` (``motion.sample_motion``):
+    (moving objects with matrices in metres, camera steps, camera matrices, view sizes,
+    the frame's view size)."""
     from . import camera, mesh, motion
 
     s = ctx.unit_scale
@@ -239,6 +250,16 @@ def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
     for om in moving:
         om.matrices = om.matrices.copy()
         om.matrices[:, :3, :] *= s
+    return moving, camera_steps, camera_matrices, view_sizes, size
+
+
+def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
+    """The scene's MotionBlur; sets the camera's motion (the frame is set back afterwards)."""
+    from . import camera, motion
+
+    s = ctx.unit_scale
+    moving, camera_steps, camera_matrices, view_sizes, size = _sample_layout(
+        ctx, depsgraph, frame_set, shutter, layout)
     if camera_steps:
         times = motion.step_times(camera_steps)
         cam.motion = np.stack([cam.matrix_world if t == 0.0 else
@@ -248,6 +269,26 @@ def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
     settings = shutter.settings()
     settings.objects = moving
     return settings
+
+
+def _export_motion_vectors(ctx, depsgraph, frame_set, vectors, layout, cam) -> MotionVectors:
+    """The objects and the camera at the previous and the next frame, for the Vector pass."""
+    from . import camera
+
+    moving, camera_steps, camera_matrices, view_sizes, size = _sample_layout(
+        ctx, depsgraph, frame_set, vectors, layout)
+    out = MotionVectors(objects=[om for om in moving if om.positions is not None or not all(
+        np.array_equal(m, om.matrices[1]) for m in om.matrices)])
+    if camera_steps:
+        out.camera = np.stack([camera.without_scale(camera_matrices[t], ctx.unit_scale)
+                               for t in (-1.0, 1.0)])
+        if cam.type == "ORTHO" and not all(np.allclose(m, cam.matrix_world) for m in out.camera):
+            ctx.warn("Vector pass: Cycles projects the motion of a moving orthographic camera as "
+                     "if it were perspective; MC Engine writes the orthographic motion",
+                     "Vector pass with a moving orthographic camera")
+    if cam.type == "PERSP":
+        out.view_scale = (view_sizes.get(-1.0, size) / size, view_sizes.get(1.0, size) / size)
+    return out
 
 
 def _instance_name(inst) -> str:

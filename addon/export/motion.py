@@ -14,6 +14,12 @@ deform them also keep their vertex positions at the steps (dropped when the
 vertex count changes, as Cycles does).  Lamps do not move in Cycles, and do
 not here.  The shutter curve is sampled at 257 points as Cycles samples it;
 ``cycles.rolling_shutter_type`` TOP reads the rows out from the top.
+
+The Vector pass (motion vectors), which Cycles fills only with motion blur off,
+takes the scene at the previous and the next frame the same way: a shutter of
+two frames centred on the frame (Cycles' ``motion_shutter_time`` for the pass),
+every object at three steps whatever its motion blur settings, the camera at its
+own steps.
 """
 from __future__ import annotations
 
@@ -24,10 +30,12 @@ import numpy as np
 from mcengine.kernels.camera import view_plane
 from mcengine.scene import MotionBlur, ObjectMotion
 
-__all__ = ["Shutter", "shutter", "instance_key", "motion_steps", "sample_motion"]
+__all__ = ["Shutter", "shutter", "vector_shutter", "instance_key", "motion_steps",
+           "sample_motion", "VECTOR_STEPS"]
 
 CURVE_SAMPLES = 257          # Cycles' RAMP_TABLE_SIZE + 1
 MAX_MOTION_STEPS = 129       # Cycles' Object::MAX_MOTION_STEPS
+VECTOR_STEPS = 3             # every object's steps for the Vector pass (Cycles' MOTION_PASS)
 
 
 @dataclass
@@ -75,6 +83,16 @@ def shutter(scene, view_layer) -> Shutter | None:
                    frame=scene.frame_current, subframe=float(scene.frame_subframe))
 
 
+def vector_shutter(scene, view_layer) -> Shutter | None:
+    """The previous and the next frame as a shutter, when the view layer's Vector pass is on
+    and motion blur off (else None: Cycles then leaves the pass at 0)."""
+    if not getattr(view_layer, "use_pass_vector", False) or (
+            scene.render.use_motion_blur and view_layer.use_motion_blur):
+        return None
+    return Shutter(length=2.0, position="CENTER", curve=None, frame=scene.frame_current,
+                   subframe=float(scene.frame_subframe))
+
+
 def motion_steps(ob, parent=None) -> int:
     """Cycles' object_motion_steps: 0 without motion blur, else 2^steps + 1 (the
     instancer's setting too for an instance)."""
@@ -90,14 +108,15 @@ def motion_steps(ob, parent=None) -> int:
     return min((2 << (steps - 1)) + 1, MAX_MOTION_STEPS)
 
 
-def deforms(ob, parent, scene) -> bool:
-    """Cycles' use of deformation motion: ``use_deform_motion`` (and the instancer's), and a
-    mesh that something may deform: ``is_deform_modified``, or any instance's data (Cycles
-    cannot tell whether geometry made by an instancer is animated)."""
-    if not getattr(ob.cycles, "use_deform_motion", False):
-        return False
+def deforms(ob, parent, scene, vectors: bool = False) -> bool:
+    """Cycles' use of deformation motion: ``use_deform_motion`` (and the instancer's; not
+    for the Vector pass, ``vectors``, which takes every deformation), and a mesh that
+    something may deform: ``is_deform_modified``, or any instance's data (Cycles cannot tell
+    whether geometry made by an instancer is animated)."""
     if parent is not None and parent != ob:
-        return bool(parent.cycles.use_deform_motion)
+        return vectors or bool(ob.cycles.use_deform_motion and parent.cycles.use_deform_motion)
+    if not (vectors or getattr(ob.cycles, "use_deform_motion", False)):
+        return False
     return bool(ob.original.is_deform_modified(scene, "RENDER"))
 
 

@@ -102,7 +102,8 @@ PV_MIST_FALLOFF = 2
 PV_ALPHA_THRESHOLD = 3
 PV_ORTHO = 4               # 1: orthographic camera (mist is the distance along the view axis)
 PV_CAMERA = 5              # 12: world to camera (Cycles' camera space: +z forward), rows x, y, z
-PV_SIZE = 17
+PV_RASTER = 17             # 3 x 12: world to raster (rows x, y, w) now, at the previous and the
+PV_SIZE = 53               # next frame (Vector pass; raster y points up, as Cycles')
 
 # Kinds of light (light_pass).
 LK_SURFACE = 0             # emission of a surface or a lamp
@@ -119,6 +120,7 @@ PassData = namedtuple("PassData", [
     "tri_uv",        # (T, 3, 3) f32      UV at each corner, 1 if the mesh has UVs (UV pass)
     "tri_object",    # (T, 3) f32         object pass index, Cryptomatte object and asset ids
     "mat_info",      # (M, 2) f32         material pass index, Cryptomatte material id
+    "tri_motion",    # (T, 2, 3, 3) f32   corners at the previous and the next frame (Vector)
 ])
 
 PassBuffers = namedtuple("PassBuffers", [
@@ -361,6 +363,8 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
                 v = b0 * pd.tri_uv[p, 0, 1] + b1 * pd.tri_uv[p, 1, 1] + b2 * pd.tri_uv[p, 2, 1]
                 w = b0 * pd.tri_uv[p, 0, 2] + b1 * pd.tri_uv[p, 1, 2] + b2 * pd.tri_uv[p, 2, 2]
                 _add3(fp, pix, c[P_UV], u * w, v * w, w)   # (0, 0, 0) without a UV map
+            if c[P_VECTOR] >= 0:
+                _motion_vector(pd, fp, pix, c[P_VECTOR], hx, hy, hz, p, b1, b2)
             flags |= PF_PASS_DONE
     slots = c[PC_CRYPTO_SLOTS]
     if slots > 0:
@@ -406,6 +410,33 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
         # Summed as 1 - mist (background rays add nothing); readout takes 1 - mean.
         fp[pix, c[P_MIST]] += (1.0 - mist) * (br * ar + bg * ag + bb * ab) / 3.0
     return flags
+
+
+@device
+def _raster(f, k, x, y, z):
+    """Raster position of a world point through the projection at ``fcfg[k:k + 12]``."""
+    w = f[k + 8] * x + f[k + 9] * y + f[k + 10] * z + f[k + 11]
+    return ((f[k] * x + f[k + 1] * y + f[k + 2] * z + f[k + 3]) / w,
+            (f[k + 4] * x + f[k + 5] * y + f[k + 6] * z + f[k + 7]) / w)
+
+
+@device
+def _motion_vector(pd, fp, pix, o, hx, hy, hz, p, b1, b2):
+    """Cycles' primitive_motion_vector, summed with a weight of 1: (previous - now, now -
+    next) raster positions of the hit point, which moves with its triangle's corners."""
+    f = pd.fcfg
+    b0 = 1.0 - b1 - b2
+    m = pd.tri_motion
+    cx, cy = _raster(f, PV_RASTER, hx, hy, hz)
+    for s in range(2):
+        x = b0 * m[p, s, 0, 0] + b1 * m[p, s, 1, 0] + b2 * m[p, s, 2, 0]
+        y = b0 * m[p, s, 0, 1] + b1 * m[p, s, 1, 1] + b2 * m[p, s, 2, 1]
+        z = b0 * m[p, s, 0, 2] + b1 * m[p, s, 1, 2] + b2 * m[p, s, 2, 2]
+        rx, ry = _raster(f, PV_RASTER + 12 * (s + 1), x, y, z)
+        sign = 1.0 if s == 0 else -1.0
+        fp[pix, o + 2 * s] += sign * (rx - cx)
+        fp[pix, o + 2 * s + 1] += sign * (ry - cy)
+    fp[pix, o + 4] += 1.0
 
 
 @device

@@ -145,3 +145,56 @@ def test_shutter_curve_and_rolling_shutter(scene, fake_session):
     np.testing.assert_allclose(mb.shutter_curve[[0, 32, 64, 128, 200]], [0.0, 0.25, 0.5, 1.0, 1.0],
                                atol=1e-3)
     assert mb.rolling_shutter and mb.rolling_shutter_duration == pytest.approx(0.4)
+
+
+def _keyed(ob, prop, frames_values):
+    for frame, value in frames_values:
+        setattr(ob, prop, value)
+        ob.keyframe_insert(prop, frame=frame)
+
+
+def test_vector_pass_takes_the_previous_and_next_frames(scene, fake_session):
+    """The Vector pass without motion blur: every object (its own motion blur off or not)
+    and the camera at frames 0 and 2 of frame 1, from Blender's evaluation there (Bezier
+    keys at -2 and 4, so the steps are not the keys); still objects are left out."""
+    scene.unit_settings.scale_length = 0.5
+    ob = new_mesh_object("Mover", SQUARE, [(0, 1, 2, 3)])
+    _keyed(ob, "location", [(-2, (0.0, 0.0, 0.0)), (4, (6.0, 3.0, 1.0))])
+    _keyed(ob, "rotation_euler", [(-2, (0.0, 0.0, 0.0)), (4, (0.0, 0.0, 1.2))])
+    ob.cycles.use_motion_blur = False
+    new_mesh_object("Still", SQUARE, [(0, 1, 2, 3)])
+    cam = scene.camera
+    _keyed(cam, "location", [(-2, (0.0, -5.0, 0.0)), (4, (2.0, -5.0, 1.0))])
+    scene.frame_set(1)
+    scene.view_layers[0].use_pass_vector = True
+    desc = export_scene(fake_session)
+    assert desc.motion_blur is None and not desc.passes.motion_blur
+    mv = desc.motion_vectors
+    (om,) = mv.objects
+    assert desc.geometry.object_names[om.object] == "Mover" and om.positions is None
+    expected = np.stack([_at(scene, t, lambda: np.array(ob.matrix_world)) for t in (0.0, 1.0, 2.0)])
+    expected[:, :3, :] *= 0.5
+    np.testing.assert_allclose(om.matrices, expected, atol=1e-5)
+    cams = np.stack([_at(scene, t, lambda: np.array(cam.matrix_world)) for t in (0.0, 2.0)])
+    np.testing.assert_allclose(mv.camera[:, :3, 3], 0.5 * cams[:, :3, 3], atol=1e-5)
+    np.testing.assert_allclose(mv.camera[:, :3, :3], cams[:, :3, :3], atol=1e-5)
+    assert scene.frame_current == 1 and scene.frame_subframe == 0.0      # put back
+
+    _motion_blur(scene)                    # Cycles leaves the pass at 0 with motion blur
+    desc = export_scene(fake_session)
+    assert desc.motion_vectors is None and desc.passes.motion_blur
+
+
+def test_vector_pass_keeps_deformation(scene, fake_session):
+    ob = new_mesh_object("Morph", SQUARE, [(0, 1, 2, 3)])
+    ob.shape_key_add(name="Basis")
+    key = ob.shape_key_add(name="Up")
+    for point in key.data:
+        point.co = (point.co.x, point.co.y, 1.0)
+    _keyed(key, "value", [(-2, 0.0), (4, 1.0)])
+    ob.cycles.use_deform_motion = False       # ignored by the pass (measured with Cycles)
+    scene.frame_set(1)
+    scene.view_layers[0].use_pass_vector = True
+    (om,) = export_scene(fake_session).motion_vectors.objects
+    heights = [_at(scene, t, lambda: key.value) for t in (0.0, 1.0, 2.0)]
+    np.testing.assert_allclose(om.positions[:, :, 2], np.repeat(heights, 4).reshape(3, 4), atol=1e-5)

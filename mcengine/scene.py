@@ -752,8 +752,8 @@ class SceneDescription:
             "integrator": dataclasses.asdict(self.integrator),
             "passes": dataclasses.asdict(self.passes),
             "denoising": dataclasses.asdict(self.denoising),
-            "motion_blur": (None if self.motion_blur is None
-                            else _plain(dataclasses.asdict(self.motion_blur))),
+            "motion_blur": _motion_meta(self.motion_blur),
+            "motion_vectors": _motion_meta(self.motion_vectors),
             "warnings": list(self.warnings),
         }
         matrix, texspace, info = g.object_arrays()
@@ -862,12 +862,8 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
     cam["matrix_world"] = np.array(cam["matrix_world"], float)
     cam["motion"] = np.array(cam.get("motion", []), float).reshape(-1, 4, 4)
     cam["view_scale_motion"] = tuple(cam.get("view_scale_motion", (1.0, 1.0)))
-    motion_blur = meta.get("motion_blur")
-    if motion_blur is not None:
-        motion_blur = dict(motion_blur)
-        if motion_blur.get("shutter_curve") is not None:
-            motion_blur["shutter_curve"] = np.array(motion_blur["shutter_curve"], float)
-        motion_blur = MotionBlur(**motion_blur)
+    motion_blur = _motion_from_meta(MotionBlur, meta.get("motion_blur"))
+    motion_vectors = _motion_from_meta(MotionVectors, meta.get("motion_vectors"))
     film = dict(meta["film"])
     if film.get("region") is not None:
         film["region"] = tuple(film["region"])
@@ -883,7 +879,40 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
         passes=RenderPasses(**{k: (tuple(v) if isinstance(v, list) else v)
                                for k, v in meta.get("passes", {}).items()}),
         denoising=Denoising(**meta.get("denoising", {})),
-        motion_blur=motion_blur, warnings=list(meta.get("warnings", [])))
+        motion_blur=motion_blur, motion_vectors=motion_vectors,
+        warnings=list(meta.get("warnings", [])))
+
+
+def _json_array(a) -> dict:
+    a = np.asarray(a)
+    return {"dtype": a.dtype.str, "shape": list(a.shape), "values": a.ravel().tolist()}
+
+
+def _array_from_json(d: dict) -> np.ndarray:
+    return np.array(d["values"], np.dtype(d["dtype"])).reshape(d["shape"])
+
+
+def _motion_meta(motion) -> dict | None:
+    """A MotionBlur or MotionVectors as JSON: its arrays and its objects' arrays with their
+    dtypes and shapes, so that a loaded scene renders the same bits."""
+    if motion is None:
+        return None
+    d = {f.name: getattr(motion, f.name) for f in dataclasses.fields(motion)}
+    d["objects"] = [{f.name: (_json_array(v) if isinstance(v := getattr(om, f.name), np.ndarray)
+                              else v) for f in dataclasses.fields(om)} for om in motion.objects]
+    return {k: (_json_array(v) if isinstance(v, np.ndarray) else v) for k, v in d.items()}
+
+
+def _motion_from_meta(kind, d: dict | None):
+    if d is None:
+        return None
+    arrays = {k: (_array_from_json(v) if isinstance(v, dict) else v) for k, v in d.items()}
+    arrays["objects"] = [ObjectMotion(**{k: (_array_from_json(v) if isinstance(v, dict)
+                                             else tuple(v) if isinstance(v, list) else v)
+                                         for k, v in om.items()}) for om in d["objects"]]
+    if "view_scale" in arrays:
+        arrays["view_scale"] = tuple(arrays["view_scale"])
+    return kind(**arrays)
 
 
 def _plain(d: dict) -> dict:

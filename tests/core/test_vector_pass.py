@@ -91,3 +91,13 @@ def test_bad_motion_is_refused():
     scene.motion_vectors = MotionVectors(camera=np.eye(4)[None])
     with pytest.raises(SceneError, match="camera must be 2"):
         scene.validate()
+
+
+def test_a_saved_scene_keeps_its_motion_vectors(tmp_path):
+    from mcengine.scene import SceneDescription
+    scene = _moving(_plane_scene(enabled=("Vector",)), (0.25, 0.125, 0.0))
+    scene.motion_vectors.camera = np.stack([look_down(4.0, x=0.1), look_down(4.0, x=-0.1)])
+    scene.save(tmp_path / "vectors.npz")
+    loaded = SceneDescription.load(tmp_path / "vectors.npz")
+    assert np.array_equal(_vectors(scene, samples=4), _vectors(loaded, samples=4))
+    assert np.abs(_vectors(loaded, samples=4)).max() > 0.5

@@ -63,6 +63,9 @@ MIN_CHUNK_PATHS = 1 << 12     # below this, per-call overhead dominates
 class RenderStats:
     """What the render did and how long it took (seconds, counts)."""
 
+    time_pack: float = 0.0          # packing the scene for the kernels: tables, shaders, the
+                                    # world's map (a first run also compiles the shader
+                                    # evaluator, which packing runs once per material)
     time_bvh: float = 0.0
     time_kernels: float = 0.0       # compiling or loading the numba kernels
     time_render: float = 0.0        # tracing and shading, wall clock
@@ -103,7 +106,8 @@ class RenderStats:
 
     def phases(self, time_export: float = 0.0) -> dict:
         """Seconds per phase; tracing and shading are summed over the worker threads."""
-        return {"export": time_export, "bvh": self.time_bvh, "kernels": self.time_kernels,
+        return {"export": time_export, "pack": self.time_pack, "bvh": self.time_bvh,
+                "kernels": self.time_kernels,
                 "tracing": self.time_embree, "shading": max(self.time_workers - self.time_embree, 0.0),
                 "render": self.time_render}
 
@@ -126,7 +130,8 @@ class RenderStats:
         t = self.phases(time_export)
         line = (f"rays/pixel: camera {r['camera']:.1f}, bounce {r['bounce']:.1f}, "
                 f"shadow {r['shadow']:.1f} | {self.rays_per_second / 1e6:.2f} Mrays/s | "
-                f"export {t['export']:.2f} s, BVH {t['bvh']:.2f} s, kernels {t['kernels']:.2f} s, "
+                f"export {t['export']:.2f} s, pack {t['pack']:.2f} s, BVH {t['bvh']:.2f} s, "
+                f"kernels {t['kernels']:.2f} s, "
                 f"tracing {t['tracing']:.2f} s, shading {t['shading']:.2f} s (thread-seconds), "
                 f"wall {t['render']:.2f} s")
         if self.texture_bytes:
@@ -249,7 +254,9 @@ class RenderSession:
         it = scene.integrator
         self.stats = RenderStats(samples_target=it.samples)
         # The effects plan (``features``): what the scene calls for, as kernel flags.
+        t0 = time.perf_counter()
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
+        self.stats.time_pack = time.perf_counter() - t0
         self.stats.texture_bytes = int(self.sc.tex.pix8.nbytes + self.sc.tex.pixf.nbytes)
         self.integrator = integrator_info(it.name)
         self.warnings = []             # what this integrator renders differently, in words

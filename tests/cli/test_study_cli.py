@@ -141,5 +141,5 @@ def test_render_with_an_integrator_prints_its_ray_accounting(scenes, tmp_path):
     line = accounting[0]
     # two camera rays per pixel; the default cube has no mirror, so Whitted casts no bounce ray
     assert line.startswith("mcengine: rays/pixel: camera 2.0, bounce 0.0, shadow ")
-    for phase in ("Mrays/s", "export", "BVH", "kernels", "tracing", "shading"):
+    for phase in ("Mrays/s", "export", "pack", "BVH", "kernels", "tracing", "shading"):
         assert phase in line

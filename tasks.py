@@ -1,7 +1,8 @@
 """Project tasks: set up the environment and run a job in it.
 
     python3.11 tasks.py demo        render blend_scenes/cornell_box.blend with MC Engine and Cycles
-    python3.11 tasks.py test [ARGS] run the whole test suite (ARGS go to pytest)
+    python3.11 tasks.py test [ARGS] run the test suite (ARGS go to pytest); tests marked slow
+                                    (minutes each) only with -m slow, or all with -m ''
     python3.11 tasks.py extension   build the Blender extension zip (dist/extension/)
 
 Needs only Python 3.11 (bpy 5.0.1, Blender 5.0 as a module, exists for 3.11 only)
@@ -115,7 +116,9 @@ def run_in_venv(command: list[str]) -> int:
 
 
 def job_test(extra: list[str]) -> int:
-    return run_in_venv(["python", "-m", "pytest", "-q", *extra])
+    # The default run (CI's) leaves out the tests marked slow, unless ARGS choose markers.
+    markers = [] if any(a == "-m" or a.startswith("-m") for a in extra) else ["-m", "not slow"]
+    return run_in_venv(["python", "-m", "pytest", "-q", *markers, *extra])
 
 
 def job_demo(extra: list[str]) -> int:

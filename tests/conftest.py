@@ -4,5 +4,5 @@
 def pytest_configure(config):
     config.addinivalue_line(
         "markers",
-        "slow: takes minutes (e.g. builds and installs the Blender extension); "
-        "part of the full suite, deselect with -m 'not slow'")
+        "slow: takes minutes (e.g. builds and installs the Blender extension); left out of "
+        "tasks.py test's default run (CI's), run with -m slow or -m ''")

@@ -34,6 +34,7 @@ import numpy as np
 
 from . import cryptomatte
 from .kernels import passes as kp
+from .kernels.camera import camera_axes, view_plane
 
 __all__ = ["PassInfo", "PASSES", "CRYPTO_TYPES", "DENOISING_PASSES", "NOISY_IMAGE", "RenderPasses",
            "Layout", "layout", "read", "MIST_FALLOFFS", "UNSUPPORTED", "SPLIT_DIFFERS",
@@ -343,11 +344,9 @@ def kernel_data(lay: Layout, passes: RenderPasses, camera_to_world: np.ndarray, 
 def world_to_camera(camera_to_world: np.ndarray) -> np.ndarray:
     """(3, 4) rows of Cycles' world-to-camera transform: x right, y up, z forward (the
     Blender camera looks along its local -Z), axes normalised."""
-    m = np.asarray(camera_to_world, np.float64)
-    axes = m[:3, :3] / np.linalg.norm(m[:3, :3], axis=0)
-    axes = axes * np.array([1.0, 1.0, -1.0])
-    rot = axes.T
-    return np.concatenate([rot, (-rot @ m[:3, 3])[:, None]], axis=1)
+    axes = camera_axes(camera_to_world)
+    rot = axes[:3, :3].T
+    return np.concatenate([rot, (-rot @ axes[:3, 3])[:, None]], axis=1)
 
 
 def world_to_raster(camera_to_world: np.ndarray, cam, width: int, height: int,
@@ -357,7 +356,6 @@ def world_to_raster(camera_to_world: np.ndarray, cam, width: int, height: int,
     ``cam`` (a ``scene.Camera``) placed at ``camera_to_world``.  ``view_scale`` scales a
     perspective camera's view plane (a focal length other than the frame's, as
     ``Camera.view_scale_motion``)."""
-    from .kernels.camera import view_plane
     half_w, half_h, shift_x, shift_y = view_plane(cam, width, height, pixel_aspect)
     to_cam = world_to_camera(camera_to_world)
     sx, sy = width / (2.0 * half_w), height / (2.0 * half_h)

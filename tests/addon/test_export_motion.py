@@ -84,12 +84,18 @@ def test_static_objects_do_not_move_in_the_kernels(scene, fake_session):
     assert len(pack_motion(desc.geometry, desc.motion_blur.objects).tri_slot) == 0
 
 
-def test_shape_key_deformation_is_kept_at_the_steps(scene, fake_session):
+def _morph_square():
+    """A square with a shape key "Up" that lifts it to z = 1: (object, key block)."""
     ob = new_mesh_object("Morph", SQUARE, [(0, 1, 2, 3)])
     ob.shape_key_add(name="Basis")
     key = ob.shape_key_add(name="Up")
     for point in key.data:
         point.co = (point.co.x, point.co.y, 1.0)
+    return ob, key
+
+
+def test_shape_key_deformation_is_kept_at_the_steps(scene, fake_session):
+    ob, key = _morph_square()
     key.value = 0.0
     key.keyframe_insert("value", frame=0)
     key.value = 1.0
@@ -186,11 +192,7 @@ def test_vector_pass_takes_the_previous_and_next_frames(scene, fake_session):
 
 
 def test_vector_pass_keeps_deformation(scene, fake_session):
-    ob = new_mesh_object("Morph", SQUARE, [(0, 1, 2, 3)])
-    ob.shape_key_add(name="Basis")
-    key = ob.shape_key_add(name="Up")
-    for point in key.data:
-        point.co = (point.co.x, point.co.y, 1.0)
+    ob, key = _morph_square()
     _keyed(key, "value", [(-2, 0.0), (4, 1.0)])
     ob.cycles.use_deform_motion = False       # ignored by the pass (measured with Cycles)
     scene.frame_set(1)

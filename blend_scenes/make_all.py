@@ -47,6 +47,8 @@ SCENES = (
     "texture_image",
     "texture_normal_map",
     "texture_bump",
+    "texture_checker_lights",
+    "attribute_vertex_colors",
 )
 
 

@@ -40,7 +40,9 @@ def test_scenes_exist():
             "light_area_spread", "light_point_large", "light_spot_shapes", "light_sun_wide",
             "transforms", "instancing_modifiers", "camera_sensor_fit", "camera_portrait_wide",
             "camera_ortho", "camera_dof", "camera_dof_ortho",
-            "motion_transform", "motion_camera", "motion_deform"} <= names
+            "motion_transform", "motion_camera", "motion_deform",
+            # textured scenes of issue 10
+            "texture_checker_lights", "attribute_vertex_colors"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

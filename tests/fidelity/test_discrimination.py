@@ -146,3 +146,36 @@ def test_cycles_agrees_with_itself_across_seeds(blend, renders):
     result = build_comparison(f"{name} (Cycles vs Cycles)", other, renders.runs(name, "cycles"),
                               grid=options.grid, alpha=options.alpha)
     assert result.verdict == "agree", result.agreement.summary()
+
+
+def _checker_squares_swapped(scene):
+    """The floor's two checker colours exchanged, as a checker counted from the wrong
+    origin (or coordinates off by one square) would draw it."""
+    node = next(n for n in bpy.data.materials["Floor"].node_tree.nodes if n.type == "TEX_CHECKER")
+    first = tuple(node.inputs["Color1"].default_value)
+    node.inputs["Color1"].default_value = node.inputs["Color2"].default_value
+    node.inputs["Color2"].default_value = first
+
+
+def _byte_colours_undecoded(scene):
+    """Every byte colour attribute's 8-bit sRGB values taken as linear, as a reader that
+    forgets to decode them would take them."""
+    for ob in scene.objects:
+        if ob.type != "MESH":
+            continue
+        for attr in ob.data.color_attributes:
+            if attr.data_type == "BYTE_COLOR":
+                for corner in attr.data:
+                    corner.color = corner.color_srgb
+
+
+@pytest.mark.parametrize("name,what,edit", [
+    ("texture_checker_lights", "checker colours swapped", _checker_squares_swapped),
+    ("attribute_vertex_colors", "byte colours not decoded from sRGB", _byte_colours_undecoded),
+])
+def test_texture_errors_are_caught(renders, name, what, edit):
+    """A checker floor off by one square, vertex-painted colours read without their sRGB
+    decoding: the blocks over those surfaces differ."""
+    result = renders.compare(name, what, edit)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

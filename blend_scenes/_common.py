@@ -295,10 +295,35 @@ def save_texture(name, pixels, float_buffer=False):
         image.file_format = "PNG"
         image.save()
         bpy.data.images.remove(image)
-    loaded = bpy.data.images.load(str(path))
-    loaded.colorspace_settings.name = "Linear Rec.709" if float_buffer else "sRGB"
+    return load_texture(name, "Linear Rec.709" if float_buffer else "sRGB")
+
+
+def load_texture(name, colorspace="sRGB"):
+    """Load ``textures/<name>`` (written by a generator) as an image that the .blend refers
+    to by its relative path, read in ``colorspace`` ('sRGB', 'Non-Color', 'Linear Rec.709')."""
+    loaded = bpy.data.images.load(str(TEXTURES_DIR / name))
+    loaded.colorspace_settings.name = colorspace
     loaded.filepath = "//textures/" + name
     return loaded
+
+
+def environment_world(scene, strength=1.0, map_resolution=1024):
+    """An HDRI world: an Environment Texture (equirectangular) into the Background's
+    Color, times ``strength``, sampled with a ``map_resolution`` importance map (World >
+    Settings > Sampling Manual).  Returns the Environment Texture node: set its ``image``.
+
+    A map finer than the image: an image-sized map (Automatic) is baked at texel centres
+    and misses the part of a small sun's bilinear footprint that lies between them.
+    """
+    world = set_world(scene, (0.0, 0.0, 0.0))
+    tree = world.node_tree
+    background = tree.nodes["Background"]
+    background.inputs["Strength"].default_value = strength
+    env = shader_node(tree, "ShaderNodeTexEnvironment", location=(-300.0, 0.0))
+    tree.links.new(env.outputs["Color"], background.inputs["Color"])
+    world.cycles.sampling_method = "MANUAL"
+    world.cycles.sample_map_resolution = map_resolution
+    return env
 
 
 def image_texture(tree, image, location=(-300.0, 0.0), **values):
@@ -440,17 +465,23 @@ def add_cylinder(scene, name, radius, height, material, segments=SPHERE_SEGMENTS
     return obj
 
 
-def add_suzanne(scene, name, material, subdivision_levels=2, **transform):
+def add_suzanne(scene, name, material, subdivision_levels=2, uv_map=False, **transform):
     """Add Blender's monkey head (the data of ``bmesh.ops.create_monkey``, 2 m wide,
-    facing -Y) with a Subdivision Surface modifier and smooth shading."""
+    facing -Y) with a Subdivision Surface modifier and smooth shading; with ``uv_map``,
+    also the monkey's own UV unwrap (what Add > Mesh > Monkey makes) as ``UVMap``."""
     import bmesh
 
     bm = bmesh.new()
-    bmesh.ops.create_monkey(bm)
+    layer = bm.loops.layers.uv.new("UVMap") if uv_map else None
+    bmesh.ops.create_monkey(bm, calc_uvs=uv_map)
     vertices = [tuple(v.co) for v in bm.verts]
     faces = [tuple(v.index for v in f.verts) for f in bm.faces]
+    uvs = [tuple(loop[layer].uv) for f in bm.faces for loop in f.loops] if uv_map else []
     bm.free()
     obj = add_mesh(scene, name, vertices, faces, material, smooth=True, **transform)
+    if uv_map:  # from_pydata keeps the faces' order and each face's loop order
+        layer = obj.data.uv_layers.new(name="UVMap")
+        layer.data.foreach_set("uv", [x for uv in uvs for x in uv])
     if subdivision_levels:
         modifier = obj.modifiers.new("Subdivision", "SUBSURF")
         modifier.levels = subdivision_levels

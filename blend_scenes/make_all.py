@@ -49,6 +49,8 @@ SCENES = (
     "texture_bump",
     "texture_checker_lights",
     "attribute_vertex_colors",
+    "texture_suzanne_maps",
+    "world_hdri_interior",
 )
 
 

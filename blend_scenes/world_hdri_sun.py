@@ -43,17 +43,8 @@ def sky_pixels():
 
 
 def build(scene):
-    world = c.set_world(scene, (0.0, 0.0, 0.0))
-    tree = world.node_tree
-    background = tree.nodes["Background"]
-    background.inputs["Strength"].default_value = STRENGTH
-    env = c.shader_node(tree, "ShaderNodeTexEnvironment", location=(-300.0, 0.0))
+    env = c.environment_world(scene, strength=STRENGTH, map_resolution=1024)
     env.image = c.save_texture("sky_small_sun.exr", sky_pixels(), float_buffer=True)
-    tree.links.new(env.outputs["Color"], background.inputs["Color"])
-    # A map finer than the image: an image-sized map (Automatic) is baked at texel centres
-    # and misses the part of the sun's bilinear footprint that lies between them.
-    world.cycles.sampling_method = "MANUAL"
-    world.cycles.sample_map_resolution = 1024
     stage = c.add_stage(scene)
     camera = stage["camera"]
     camera.location = (0.0, -6.0, 1.8)

@@ -109,6 +109,26 @@ def test_missing_bump_is_caught(renders, what, edit):
     assert result.agreement.differing_blocks()
 
 
+def _read_as(image, colorspace):
+    def edit(scene):
+        bpy.data.images[image].colorspace_settings.name = colorspace
+    return edit
+
+
+@pytest.mark.parametrize("what,edit", [
+    ("normal map missing", _unlinked("SuzanneMaps", "ShaderNodeBsdfPrincipled", "Normal")),
+    ("roughness map read as sRGB", _read_as("suzanne_roughness.png", "sRGB")),
+    ("colour map read as Non-Color", _read_as("suzanne_color.png", "Non-Color")),
+])
+def test_texture_map_errors_are_caught(renders, what, edit):
+    """The image-textured Suzanne without its normal map (measured: frame R +7.6 %), or with
+    an image decoded in the wrong colour space (the roughness map as sRGB: frame within
+    0.7 %, but 7 blocks; the colour map as Non-Color: +13 to +27 %): the blocks differ."""
+    result = renders.compare("texture_suzanne_maps", what, edit)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 def _no_motion_blur(scene):
     scene.render.use_motion_blur = False
 

@@ -42,7 +42,8 @@ def test_scenes_exist():
             "camera_ortho", "camera_dof", "camera_dof_ortho",
             "motion_transform", "motion_camera", "motion_deform",
             # textured scenes of issue 10
-            "texture_checker_lights", "attribute_vertex_colors"} <= names
+            "texture_checker_lights", "attribute_vertex_colors", "texture_suzanne_maps",
+            "world_hdri_interior"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

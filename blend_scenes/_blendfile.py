@@ -11,8 +11,11 @@ describe the scene:
   it only has to be unique within its node tree.
 * ``ScrEdge.v1``/``v2``: the two vertices of a UI screen edge, stored in the
   order of their run-time memory addresses.  The edge is undirected.
+* ``Image.name`` (``filepath`` in Python): setting a shorter path (the relative ``//textures/...``)
+  over the absolute one it was loaded from leaves the end of the old path after
+  the NUL, so the file depended on the folder it was built in.
 
-:func:`normalize` rewrites exactly these fields in place: the padding and the
+:func:`normalize` rewrites exactly these fields in place: the paddings and the
 seed become 0, node identifiers become 1, 2, 3, ... in file order (unique
 in the whole file, hence in each tree), and each screen edge lists its
 vertices in the order of their (reproducible) file addresses.  Field offsets are read from the
@@ -82,6 +85,9 @@ def normalize(raw: bytearray, colorspace_name: str, mark_compressed: bool = Fals
             for i in range(count):
                 struct.pack_into("<i", raw, start + i * size + offset, next_node_id)
                 next_node_id += 1
+        elif name == "Image" and code == b"IM\0\0":
+            offset, length = fields["name"]       # DNA name of Image.filepath
+            _zero_after_nul(raw, start + offset, length)
         elif name == "ScrEdge" and code == b"DATA":
             for i in range(count):
                 _sort_pointer_pair(raw, start + i * size + fields["v1"][0],
@@ -114,6 +120,11 @@ def _zero_string_padding(raw, start, size, expected):
         raise ValueError(f"expected colour-space name {expected!r} in the file header")
     end_of_name = start + len(name) + 1
     raw[end_of_name:start + size] = bytes(start + size - end_of_name)
+
+
+def _zero_after_nul(raw, start, size):
+    end = raw.index(b"\0", start, start + size) + 1
+    raw[end:start + size] = bytes(start + size - end)
 
 
 def _parse_sdna(dna):

@@ -141,7 +141,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         tex=TextureData(attr=attr, normals=normals,
                         tri_object=np.ascontiguousarray(g.object_index, np.int32),
                         objects=pack_objects(g), camera=camera, images=images.info,
-                        pix8=images.pix8, pixf=images.pixf, verts=verts, tris=tris),
+                        pix8=images.pix8, pixf=images.pixf),
         motion=pack_motion(g, scene.motion_blur.objects if scene.motion_blur else []),
         bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)))
 

@@ -196,6 +196,8 @@ class _Compiler:
         Strength 1, the node's default filter width; in object space for method 'BOTH')
         whose Height is the displacement dotted with the Geometry node's Normal; its normal
         becomes the shading normal for the rest of the program."""
+        header = len(self.program.ops)
+        self.program.ops.append([OP_BUMP, BUMP_SET_NORMAL, 0, 0])     # completed below
         k = len(self.nodes)
         self.nodes = self.nodes + [
             ShaderNode("NewGeometry"),
@@ -205,7 +207,7 @@ class _Compiler:
                        {"use_object_space": float(self.material.displacement_method == "BOTH")})]
         normal = self.output(Link(k + 2, "Normal"))
         reg = normal.reg if not normal.constant else self.program.store(normal.const)
-        self.program.ops.append([OP_BUMP, BUMP_SET_NORMAL, reg, 0])
+        self.program.ops[header] = [OP_BUMP, BUMP_SET_NORMAL, reg, len(self.program.ops) - header]
         # Nodes after this see the bumped normal: the surface compiles its own copies.
         self.outputs, self.implicit = {}, {}
 
@@ -223,11 +225,13 @@ class _Compiler:
             return values
         width_reg = self.program.store((width,))
         for axis, i in ((BUMP_DX, dx), (BUMP_DY, dy)):
-            self.program.ops.append([OP_BUMP, axis, width_reg, 0])
+            enter = len(self.program.ops)
+            self.program.ops.append([OP_BUMP, axis, width_reg, 0])     # completed below
             saved = self.outputs, self.implicit
             self.outputs, self.implicit = {}, {}
             values[i] = self.converted(self.output(height), FLOAT)
             self.outputs, self.implicit = saved
+            self.program.ops[enter][3] = len(self.program.ops) - enter
             self.program.ops.append([OP_BUMP, BUMP_LEAVE, 0, 0])
         return values
 
@@ -454,8 +458,8 @@ _NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zero
                            tri_object=np.zeros(0, np.int32),
                            objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
                            images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
-                           pixf=np.zeros(0, np.float32), verts=np.zeros((0, 3)),
-                           tris=np.zeros((0, 3), np.int32))
+                           pixf=np.zeros(0, np.float32))
+_NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32))     # verts, tris (SceneData's types)
 
 
 class ShaderTable:
@@ -496,7 +500,7 @@ class ShaderTable:
         for i, (m, program) in enumerate(zip(materials, programs)):
             point = point._replace(bump_correction=m.use_bump_map_correction)
             res = eval_shader(self.ops, self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
-                              _NO_TEXTURES)
+                              _NO_TEXTURES, *_NO_MESH)
             self.emission[i] = np.maximum((res.er, res.eg, res.eb), 0.0)
             flags = MF_BUMP_CORRECTION if m.use_bump_map_correction else 0
             if self.emission[i].max() > 0.0 or program.emission_varies:

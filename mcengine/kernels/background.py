@@ -45,7 +45,7 @@ def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
                      i64(0), i64(0), i64(0), i64(0), i64(0), 0.0)
     w = sc.mat_prog.shape[0] - 1
     res = eval_shader(sc.svm_ops, sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs,
-                      scratch.cl_light, sd, sc.tex)
+                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris)
     return res.er, res.eg, res.eb
 
 

@@ -303,7 +303,7 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
                       (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
                       p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths, footprint)
     return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
-                       sd, sc.tex)
+                       sd, sc.tex, sc.verts, sc.tris)
 
 
 @device
@@ -318,7 +318,7 @@ def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths, time):
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
                       sc.tex.tri_object[tri], PF_EMISSION, dist, depths, 0.0)
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                      scratch.cl_light, sd, sc.tex)
+                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris)
     return res.er, res.eg, res.eb
 
 

@@ -18,11 +18,16 @@ and writes its closures at this point into the closure list ``cl`` (see
                    c = first of two registers: in x (1 - fac), in x fac
 ``OP_CLOSURE``     a = node kind (``nodes.K_*``), b = its first input register,
                    c = weight register (-1: 1): build the node's closures
-``OP_BUMP``        a = ``BUMP_*``: the rows up to the next BUMP_LEAVE see the point moved
-                   along dPdx (BUMP_DX) or dPdy (BUMP_DY) by the filter width in register b
-                   (a Bump node's Height sub-graph, ``bump.bump_point``), BUMP_LEAVE restores
-                   it; BUMP_SET_NORMAL: the shading normal becomes the vector in register b
-                   for the rest of the program (displacement as bump)
+``OP_BUMP``        a = ``BUMP_DX`` or ``BUMP_DY``: the rows after it, up to its BUMP_LEAVE row c
+                   rows further on, run at the point moved along dPdx or dPdy by the filter
+                   width in register b (a Bump node's Height sub-graph, ``bump.bump_point``);
+                   a = ``BUMP_SET_NORMAL``, only as a program's first row: the rows after it,
+                   up to c rows further on, run first (the output's Displacement), then the
+                   shading normal is the vector in register b for the rest of the program
+                   (displacement as bump)
+
+Those rows hold nothing but value nodes; ``eval_values`` runs them at the moved point,
+so the point ``eval_shader``'s loop shades never changes inside it.
 
 The result is the number of closures, the emitted radiance, the transparency
 (the summed weight of transparent closures, which shadow rays pass through)
@@ -96,7 +101,7 @@ ShaderResult = namedtuple("ShaderResult", [
 ])
 
 
-@function
+@device
 def eval_node(code, regs, b, c, sd, tex):
     """Evaluate value node ``code``: inputs at regs[b:], outputs to regs[c:]."""
     family = code // 100
@@ -131,15 +136,53 @@ def convert(regs, a, b, kind):
         regs[a + 2] = f
 
 
+@device
+def eval_row(ops, pc, regs, sd, tex):
+    """One value row: OP_NODE, OP_COPY or OP_CONVERT."""
+    op = ops[pc, 0]
+    a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
+    if op == OP_NODE:
+        eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
+    elif op == OP_COPY:
+        for k in range(c):
+            regs[a + k] = regs[b + k]
+    elif op == OP_CONVERT:
+        convert(regs, a, b, c)
+
+
 @function
-def eval_shader(ops, start, end, regs, cl, sd, tex):
-    """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`."""
+def eval_values(ops, start, end, regs, sd, tex, verts, tris):
+    """Run value rows [start, end) at ``sd``: the Height sub-graph of a Bump node, or the
+    output's Displacement; a Bump node in there moves the point again from ``sd``."""
+    point = sd
+    for pc in range(start, end):
+        if ops[pc, 0] == OP_BUMP:
+            if ops[pc, 1] == BUMP_LEAVE:
+                point = sd
+            else:
+                point = bump_point(sd, verts, tris, regs[ops[pc, 2]], ops[pc, 1])
+        else:
+            eval_row(ops, pc, regs, point, tex)
+
+
+@function
+def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
+    """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`.
+    ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point
+    (not in ``tex``: every node function takes that, and a call copies its arrays)."""
     n = 0
     er = eg = eb = 0.0
     tr = tg = tb = 0.0
     holdout = 0.0
-    point = sd               # the unmoved point (OP_BUMP)
+    if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:
+        surface, b = start + ops[start, 3], ops[start, 2]
+        eval_values(ops, start + 1, surface, regs, sd, tex, verts, tris)
+        sd = with_normal(sd, regs[b], regs[b + 1], regs[b + 2])
+        start = surface
+    skip = start             # rows before it were run by eval_values
     for pc in range(start, end):
+        if pc < skip:
+            continue
         op = ops[pc, 0]
         a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
         if op == OP_CLOSURE:
@@ -155,24 +198,14 @@ def eval_shader(ops, start, end, regs, cl, sd, tex):
             tg += dtg
             tb += dtb
             holdout += dh
-        elif op == OP_NODE:
-            eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
-        elif op == OP_COPY:
-            for k in range(c):
-                regs[a + k] = regs[b + k]
-        elif op == OP_CONVERT:
-            convert(regs, a, b, c)
-        elif op == OP_BUMP:
-            if a == BUMP_LEAVE:
-                sd = point
-            elif a == BUMP_SET_NORMAL:
-                point = with_normal(point, regs[b], regs[b + 1], regs[b + 2])
-                sd = point
-            else:
-                sd = bump_point(point, tex, regs[b], a)
         elif op == OP_MIX_WEIGHT:
             fac = min(max(regs[a], 0.0), 1.0)
             w = regs[b] if b >= 0 else 1.0
             regs[c] = w * (1.0 - fac)
             regs[c + 1] = w * fac
+        elif op == OP_BUMP:
+            eval_values(ops, pc + 1, pc + c, regs, bump_point(sd, verts, tris, regs[b], a), tex, verts, tris)
+            skip = pc + c + 1
+        else:
+            eval_row(ops, pc, regs, sd, tex)
     return ShaderResult(n, er, eg, eb, tr, tg, tb, holdout)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device
+from ...jit import device, function
 from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
 from .input_nodes import normal_to_object, normal_to_world, transform_direction
 from .math_nodes import safe_normalize
@@ -66,8 +66,8 @@ def differentials(sd):
     return d * ax, d * ay, d * az, d * bx, d * by, d * bz
 
 
-@device
-def bump_point(sd, tex, width, axis):
+@function
+def bump_point(sd, verts, tris, width, axis):
     """The shading point moved by ``width`` times dPdx (axis 1) or dPdy (axis 2), with its
     barycentrics on the triangle: what a Bump node's Height sees in its x or y sample."""
     xx, xy, xz, yx, yy, yz = differentials(sd)
@@ -79,8 +79,8 @@ def bump_point(sd, tex, width, axis):
     p = sd.prim
     if p >= 0:
         # Solve e = du e1 + dv e2 in the triangle's plane (Cramer's rule about its normal).
-        t = tex.tris[p]
-        v0, v1, v2 = tex.verts[t[0]], tex.verts[t[1]], tex.verts[t[2]]
+        t = tris[p]
+        v0, v1, v2 = verts[t[0]], verts[t[1]], verts[t[2]]
         e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
         e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
         nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
@@ -109,7 +109,7 @@ def with_normal(sd, nx, ny, nz):
                        sd.transmission_depth, sd.transparent_depth, sd.dp)
 
 
-@device
+@function
 def bump_normal(regs, b, sd, tex):
     """Cycles' svm_node_set_bump: the bumped normal from the three heights."""
     nx, ny, nz = regs[b + _BUMP_NORMAL], regs[b + _BUMP_NORMAL + 1], regs[b + _BUMP_NORMAL + 2]
@@ -147,7 +147,7 @@ def bump_normal(regs, b, sd, tex):
     return ox, oy, oz
 
 
-@device
+@function
 def displacement(regs, b, sd, tex):
     """Cycles' svm_node_displacement: the displacement vector (world space)."""
     nx, ny, nz = regs[b + _DISP_NORMAL], regs[b + _DISP_NORMAL + 1], regs[b + _DISP_NORMAL + 2]

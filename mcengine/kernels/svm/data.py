@@ -39,8 +39,6 @@ TextureData = namedtuple("TextureData", [
     "images",                  # (I, IMG_STRIDE) int64  the render's images (IMG_* columns)
     "pix8",                    # (N,) uint8    texels of the 8-bit images, row after row
     "pixf",                    # (N,) float32  texels of the float images
-    "verts",                   # (V, 3) f64     the triangles (world space): the Bump node's
-    "tris",                    # (T, 3) int32   offset points on them (svm.bump_point)
 ])
 
 # Per-object data (TextureData.objects columns).

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from mcengine.kernels.shading import SHADOW_TERMINATOR_OFFSET
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
 from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
@@ -44,6 +45,8 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "holdout/shadow catcher": "these objects render as normal objects",
+    "shadow terminator offsets other than the default": "these objects use Geometry Offset 0.1 "
+                                                        "and Shading Offset 0",
     "normal maps without a UV map": "their normal maps leave the normal unchanged (Cycles takes "
                                     "tangents from generated coordinates there)",
 }
@@ -148,6 +151,10 @@ class MeshCollector:
             self._note("ray visibility", ob.name)
         if getattr(ob, "is_holdout", False) or getattr(ob, "is_shadow_catcher", False):
             self._note("holdout/shadow catcher", ob.name)
+        offset = getattr(ob, "shadow_terminator_geometry_offset", SHADOW_TERMINATOR_OFFSET)
+        if (abs(offset - SHADOW_TERMINATOR_OFFSET) > 1e-6
+                or getattr(ob, "shadow_terminator_shading_offset", 0.0) != 0.0):
+            self._note("shadow terminator offsets other than the default", ob.name)
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:

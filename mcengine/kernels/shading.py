@@ -43,6 +43,7 @@ from .closures import (
     bsdf_eval,
     bsdf_sample,
 )
+from .closures.layout import CL_NS
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
     PMF_EVERY,
@@ -84,8 +85,13 @@ from .state import (
     PF_TRANSPARENT_BG,
     ST_NONFINITE,
 )
-from .surface import surface_point
+from .surface import smooth_surface_offset, surface_point
 from .svm import ShadingData, eval_shader
+
+# Blender's default Shadow Terminator > Geometry Offset of an object: the cosine under which
+# shadow rays start from the smooth surface (``terminator_origin``).  Cycles reads it per
+# object; the add-on warns when an object sets another value.
+SHADOW_TERMINATOR_OFFSET = 0.1
 
 DirectionSample = namedtuple("DirectionSample", [
     "ok",                    # False: no direction (absorbed, or through the wrong side)
@@ -133,7 +139,31 @@ def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tm
 
 
 @device
-def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb,
+def terminator_origin(sc, sp, nx, ny, nz, wix, wiy, wiz):
+    """Where a shadow ray towards wi starts on a smooth-shaded triangle: Cycles'
+    shadow_ray_offset with Blender's default Shadow Terminator Geometry Offset.  Where the
+    light is at most that cosine above the flat triangle (or above the shader's normal n),
+    the ray starts from the curved surface the corner normals describe
+    (``surface.smooth_surface_offset``) rather than from the facet, in full once the
+    light is below the facet; so a lit smooth (or bumped) surface is not shadowed by its
+    own facets near the terminator."""
+    nl = nx * wix + ny * wiy + nz * wiz
+    ngx, ngy, ngz = sp.ngx, sp.ngy, sp.ngz
+    if nl < 0.0:
+        nl = -nl
+        ngx, ngy, ngz = -ngx, -ngy, -ngz
+    ngl = ngx * wix + ngy * wiy + ngz * wiz
+    cutoff = SHADOW_TERMINATOR_OFFSET
+    amount = 2.0 - (ngl + nl) / cutoff if nl < cutoff else 1.0 - ngl / cutoff
+    amount = min(max(amount, 0.0), 1.0)
+    if amount <= 0.0:
+        return sp.hx, sp.hy, sp.hz
+    tx, ty, tz = smooth_surface_offset(sc, sp, ngx, ngy, ngz)
+    return sp.hx + amount * tx, sp.hy + amount * ty, sp.hz + amount * tz
+
+
+@device
+def push_shadow(sq, sc, n_shadow, owner, sp, nx, ny, nz, wix, wiy, wiz, dist, lnx, lny, lnz, cr, cg, cb,
                 transparent_left, depths):
     """Queue a shadow ray from the shading point ``sp`` towards the light point.
 
@@ -142,10 +172,12 @@ def push_shadow(sq, n_shadow, owner, sp, wix, wiy, wiz, dist, lnx, lny, lnz, cr,
     target, else at grazing angles the shifted ray meets the emitter's plane
     before its end.  ``owner`` is the row the light goes to if unoccluded;
     ``transparent_left`` is how many transparent surfaces the ray may pass;
-    ``depths`` the path's bounce counts (what a Light Path node on the way sees).
+    ``depths`` the path's bounce counts (what a Light Path node on the way sees); n is the
+    shader's normal (after a displacement bump), which the shadow terminator offset reads.
     """
     hx, hy, hz = sp.hx, sp.hy, sp.hz
-    sox, soy, soz = offset_origin(hx, hy, hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
+    ox, oy, oz = terminator_origin(sc, sp, nx, ny, nz, wix, wiy, wiz)
+    sox, soy, soz = offset_origin(ox, oy, oz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
     sdx, sdy, sdz = wix, wiy, wiz
     tmax = T_INFINITE
     ex = ey = ez = math.inf
@@ -412,7 +444,9 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
     if ls.cast_shadow:
-        return push_shadow(sq, n_shadow, row, sp, ls.wix, ls.wiy, ls.wiz, ls.dist,
+        nx, ny, nz = (scratch.cl[0, CL_NS], scratch.cl[0, CL_NS + 1], scratch.cl[0, CL_NS + 2]) if ncl > 0 \
+            else (sp.nsx, sp.nsy, sp.nsz)
+        return push_shadow(sq, sc, n_shadow, row, sp, nx, ny, nz, ls.wix, ls.wiy, ls.wiz, ls.dist,
                            ls.lnx, ls.lny, ls.lnz, cr, cg, cb, transparent_left, depths)
     out[row, 0] += cr
     out[row, 1] += cg

@@ -24,6 +24,7 @@ SurfacePoint = namedtuple("SurfacePoint", [
     "backfacing",            # the ray came from the inside of the surface
     "area",                  # area of the triangle (at the path's time, for a moving one)
     "time",                  # the path's time over the shutter (0.5 without motion blur)
+    "prim", "b1", "b2",      # the triangle hit and the barycentrics of its 2nd and 3rd corners
 ])
 
 Frame = namedtuple("Frame", [
@@ -91,7 +92,47 @@ def surface_point(sc, p, b1, b2, dx, dy, dz, time):
         ngx, ngy, ngz = -ngx, -ngy, -ngz
         nsx, nsy, nsz = -nsx, -nsy, -nsz
         cos_o_geo = -cos_o_geo
-    return SurfacePoint(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing, area, time)
+    return SurfacePoint(hx, hy, hz, ngx, ngy, ngz, nsx, nsy, nsz, cos_o_geo, backfacing, area, time,
+                        p, b1, b2)
+
+
+@device
+def smooth_surface_offset(sc, sp, ngx, ngy, ngz):
+    """Cycles' shadow_ray_smooth_surface_offset: from the flat triangle at ``sp`` to the
+    curved surface its corner normals describe (a parabola through the corners, bounded by
+    the corners' tangent planes), along the interpolated corner normal; ng is the geometric
+    normal on the side the shadow ray leaves to.  Zero on a flat-shaded triangle (its
+    corner normals are its plane's)."""
+    ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, sp.prim, sp.time)
+    n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z = prim_normals(sc, sp.prim, sp.time)
+    u, v, w = 1.0 - sp.b1 - sp.b2, sp.b1, sp.b2
+    px, py, pz = u * ax + v * bx + w * cx, u * ay + v * by + w * cy, u * az + v * bz + w * cz
+    nx, ny, nz = u * n0x + v * n1x + w * n2x, u * n0y + v * n1y + w * n2y, u * n0z + v * n1z + w * n2z
+    qa = (n2x - n0x) * (ax - cx) + (n2y - n0y) * (ay - cy) + (n2z - n0z) * (az - cz)
+    qb = (n2x - n1x) * (bx - cx) + (n2y - n1y) * (by - cy) + (n2z - n1z) * (bz - cz)
+    qc = (n1x - n0x) * (bx - ax) + (n1y - n0y) * (by - ay) + (n1z - n0z) * (bz - az)
+    h = qa * u * (u - 1.0) + (qa + qb + qc) * u * v + qb * v * (v - 1.0)
+    # Tangent-plane envelope: how far each corner's plane lies above the point.
+    ab0 = (bx - ax) * n0x + (by - ay) * n0y + (bz - az) * n0z
+    ac0 = (cx - ax) * n0x + (cy - ay) * n0y + (cz - az) * n0z
+    ba1 = (ax - bx) * n1x + (ay - by) * n1y + (az - bz) * n1z
+    bc1 = (cx - bx) * n1x + (cy - by) * n1y + (cz - bz) * n1z
+    ca2 = (ax - cx) * n2x + (ay - cy) * n2y + (az - cz) * n2z
+    cb2 = (bx - cx) * n2x + (by - cy) * n2y + (bz - cz) * n2z
+    d0 = (ax - px) * n0x + (ay - py) * n0y + (az - pz) * n0z
+    d1 = (bx - px) * n1x + (by - py) * n1y + (bz - pz) * n1z
+    d2 = (cx - px) * n2x + (cy - py) * n2y + (cz - pz) * n2z
+    if nx * ngx + ny * ngy + nz * ngz > 0.0:
+        h0 = max(d0 + max(max(ab0, ac0), 0.0), 0.0)
+        h1 = max(d1 + max(max(ba1, bc1), 0.0), 0.0)
+        h2 = max(d2 + max(max(ca2, cb2), 0.0), 0.0)
+        h = max(min(min(h0, h1), h2), 0.5 * h)
+    else:
+        h0 = max(-d0 + max(max(-ab0, -ac0), 0.0), 0.0)
+        h1 = max(-d1 + max(max(-ba1, -bc1), 0.0), 0.0)
+        h2 = max(-d2 + max(max(-ca2, -cb2), 0.0), 0.0)
+        h = min(-min(min(h0, h1), h2), 0.5 * h)
+    return nx * h, ny * h, nz * h
 
 
 @device

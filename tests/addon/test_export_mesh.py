@@ -276,6 +276,16 @@ def test_hair_and_visibility_settings_are_named_once(scene, fake_session):
                      "'Ghost4' and 2 more); these objects are visible to all rays"]
 
 
+def test_shadow_terminator_offsets_other_than_the_default_are_named(scene, fake_session):
+    new_mesh_object("Default", TRI, [(0, 1, 2)])
+    new_mesh_object("Geometry", TRI, [(0, 1, 2)]).shadow_terminator_geometry_offset = 0.3
+    new_mesh_object("Shading", TRI, [(0, 1, 2)]).shadow_terminator_shading_offset = 0.2
+    desc = export_scene(fake_session)
+    assert [w for w in desc.warnings if "terminator" in w] == [
+        "shadow terminator offsets other than the default not supported yet ('Geometry', "
+        "'Shading'); these objects use Geometry Offset 0.1 and Shading Offset 0"]
+
+
 def _attribute_grid(n=6):
     """A smooth n x n grid with two UV maps (the second renders), a byte colour per corner,
     a float colour per point and a float per face read by its material's Attribute node;

@@ -8,7 +8,9 @@ Invert, Filter Width, a linked Normal input, a chain of two Bump nodes, turned, 
 back-facing planes; under a perspective camera, a fine noise whose bump depends on the
 size of the offsets, so on the camera's ray differential.  Displacement as bump: the
 Geometry node's Normal, read after the automatic bump has replaced the shading normal, is
-the emission colour.
+the emission colour.  Lit spheres: near a smooth (or bumped) low-poly sphere's shadow
+terminator, shadow rays start from the smooth surface as in Cycles (the one case here with
+a light and shadow rays).
 """
 import math
 
@@ -304,5 +306,5 @@ def test_shadow_terminator_offset_agrees_with_cycles(lit_spheres, half):
     the facet itself the ray is blocked by the sphere.  Before MC Engine did the same, its
     bumped sphere rendered 0.9 % darker than Cycles' (texture_bump at 100 %)."""
     ref, ours = (img[:48] if half == "smooth" else img[48:] for img in lit_spheres)
-    assert (ref.max(axis=2) > 0.05).mean() > 0.2          # the lit side is in view
+    assert (ref.max(axis=2) > 0.05).mean() > 0.15         # the lit side is in view
     assert_agree(half, ref, ours, rel=1e-3, abs_tol=1e-4, edge_fraction=0.0)

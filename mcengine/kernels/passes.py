@@ -169,20 +169,38 @@ def roughness_squared(cl, k):
     return 1.0
 
 
-@function
-def split_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude):
-    r"""Diffuse and glossy pass weights of the BSDF evaluated from wo towards wi (Cycles'
-    bsdf_eval_pass_diffuse_weight and _glossy_weight): the shares of F that diffuse
-    closures, and glossy ones (glass on the side of reflection), contribute.
+@device
+def _pass_kind(cl, k, t, wix, wiy, wiz):
+    """Which light pass closure k of type t scatters towards wi in: 0 diffuse (Cycles'
+    CLOSURE_IS_BSDF_DIFFUSE), 1 glossy (reflection, and glass on the side of its normal),
+    2 transmission."""
+    if is_diffuse(t):
+        return 0
+    if t == CT_MICROFACET or (t == CT_MICROFACET_GLASS and (
+            wix * cl[k, CL_N] + wiy * cl[k, CL_N + 1] + wiz * cl[k, CL_N + 2]) > 0.0):
+        return 1
+    return 2
 
-    F sums the same closures as ``closures.bsdf_eval`` (a closure the light ``exclude``\ s
-    adds nothing).  Returns (dr, dg, db, gr, gg, gb); transmission is the rest.
+
+@function
+def split_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude, pick, fr, fg, fb):
+    r"""Diffuse and glossy pass weights of the BSDF from wo towards wi (Cycles'
+    bsdf_eval_pass_diffuse_weight and _glossy_weight): the shares of F that diffuse
+    closures, and glossy ones, contribute.  Returns (dr, dg, db, gr, gg, gb); transmission
+    is the rest.
+
+    For a light sample (``pick`` -1), F sums the closures as ``closures.bsdf_eval`` does (a
+    closure the light ``exclude``\ s adds nothing).  For a direction sampled from closure
+    ``pick``, F is the list's value there that sampling found, (fr, fg, fb) (the weight
+    times the mixture pdf), and the picked closure's part is F less the other closures'
+    evaluations: its value as sampled, as Cycles' surface_shader_bsdf_sample_closure
+    keeps it (an evaluation can differ: bump shadowing rejects more directions).
     """
     dr = dg = db = gr = gg = gb = 0.0
-    fr = fg = fb = 0.0
+    sr = sg = sb = 0.0
     for k in range(n):
         t = cl[k, CL_TYPE]
-        if t == CT_NONE or t == CT_TRANSPARENT or excluded(t, exclude):
+        if k == pick or t == CT_NONE or t == CT_TRANSPARENT or excluded(t, exclude):
             continue
         r, g, b, pdf = closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz)
         if pdf == 0.0:
@@ -190,12 +208,20 @@ def split_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude):
         r *= cl[k, CL_W]
         g *= cl[k, CL_W + 1]
         b *= cl[k, CL_W + 2]
-        fr, fg, fb = fr + r, fg + g, fb + b
-        if is_diffuse(t):
+        sr, sg, sb = sr + r, sg + g, sb + b
+        kind = _pass_kind(cl, k, t, wix, wiy, wiz)
+        if kind == 0:
             dr, dg, db = dr + r, dg + g, db + b
-        elif t == CT_MICROFACET or (t == CT_MICROFACET_GLASS and (
-                wix * cl[k, CL_N] + wiy * cl[k, CL_N + 1] + wiz * cl[k, CL_N + 2]) > 0.0):
+        elif kind == 1:
             gr, gg, gb = gr + r, gg + g, gb + b
+    if pick >= 0:
+        kind = _pass_kind(cl, pick, cl[pick, CL_TYPE], wix, wiy, wiz)
+        if kind == 0:
+            dr, dg, db = dr + fr - sr, dg + fg - sg, db + fb - sb
+        elif kind == 1:
+            gr, gg, gb = gr + fr - sr, gg + fg - sg, gb + fb - sb
+    else:
+        fr, fg, fb = sr, sg, sb
     return (_safe_div(dr, fr), _safe_div(dg, fg), _safe_div(db, fb),
             _safe_div(gr, fr), _safe_div(gg, fg), _safe_div(gb, fb))
 
@@ -257,7 +283,8 @@ def shadow_pass(pd, fp, pix, pb, s, r, g, b):
 @device
 def singular_weights(label):
     """Pass weights of a singular (perfectly smooth) sample: all glossy if it reflected,
-    else all transmission (only glass and refraction closures are singular)."""
+    else all transmission.  (Cycles scales a singular lobe's value by 1e6 and adds the
+    other closures' evaluations to it, so their share there is below 1e-5.)"""
     if label & LABEL_REFLECT:
         return 0.0, 0.0, 0.0, 1.0, 1.0, 1.0
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0

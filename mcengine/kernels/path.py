@@ -331,7 +331,7 @@ def _nee_passes(pd, fp, st, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, q
     else:
         last = scratch.light
         w0, w1, w2, w3, w4, w5 = split_eval(scratch.cl, ncl, wox, woy, woz, last[0], last[1],
-                                            last[2], int(last[3]))
+                                            last[2], int(last[3]), -1, 0.0, 0.0, 0.0)
     if n_shadow > queued:
         s = n_shadow - 1
         pb.sw[s, 0], pb.sw[s, 1], pb.sw[s, 2] = w0, w1, w2
@@ -346,11 +346,13 @@ def _nee_passes(pd, fp, st, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, q
 @device
 def _first_bounce_weights(pb, i, cl, ncl, wox, woy, woz, ds):
     """Pass weights of path i's first scattering event (Cycles' pass_diffuse_weight and
-    pass_glossy_weight)."""
+    pass_glossy_weight): the shares of the BSDF's value in the sampled direction."""
     if ds.label & LABEL_SINGULAR:
         w0, w1, w2, w3, w4, w5 = singular_weights(ds.label)
     else:
-        w0, w1, w2, w3, w4, w5 = split_eval(cl, ncl, wox, woy, woz, ds.wix, ds.wiy, ds.wiz, 0)
+        w0, w1, w2, w3, w4, w5 = split_eval(cl, ncl, wox, woy, woz, ds.wix, ds.wiy, ds.wiz, 0,
+                                            ds.pick, ds.wr * ds.pdf, ds.wg * ds.pdf,
+                                            ds.wb * ds.pdf)
     pb.pw[i, 0], pb.pw[i, 1], pb.pw[i, 2] = w0, w1, w2
     pb.pw[i, 3], pb.pw[i, 4], pb.pw[i, 5] = w3, w4, w5
 

@@ -41,7 +41,7 @@ from .closures import (
     LABEL_REFLECT,
     LABEL_TRANSMIT,
     bsdf_eval,
-    bsdf_sample,
+    bsdf_sample_closure,
 )
 from .closures.layout import CL_NS
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
@@ -99,6 +99,7 @@ DirectionSample = namedtuple("DirectionSample", [
     "wr", "wg", "wb",        # weight f * |cos| / pdf
     "pdf",                   # solid-angle pdf (0 for a singular lobe)
     "label",                 # LABEL_* of the lobe sampled
+    "pick",                  # the closure sampled (its row in the closure list; -1: none)
 ])
 
 
@@ -468,7 +469,8 @@ def leaves_correct_side(sp, wix, wiy, wiz, label):
 @device
 def sample_direction(cl, ncl, sp, dx, dy, dz, u_pick, u1, u2, u3):
     """The closures sample the next direction at ``sp`` for a ray of direction d."""
-    wix, wiy, wiz, wr, wg, wb, pdf, label = bsdf_sample(cl, ncl, -dx, -dy, -dz, u_pick, u1, u2, u3)
+    wix, wiy, wiz, wr, wg, wb, pdf, label, pick = bsdf_sample_closure(cl, ncl, -dx, -dy, -dz,
+                                                                      u_pick, u1, u2, u3)
     if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not leaves_correct_side(sp, wix, wiy, wiz, label):
-        return DirectionSample(False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, label)
-    return DirectionSample(True, wix, wiy, wiz, wr, wg, wb, pdf, label)
+        return DirectionSample(False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, label, pick)
+    return DirectionSample(True, wix, wiy, wiz, wr, wg, wb, pdf, label, pick)

@@ -2,7 +2,9 @@
 
 * Light passes recompose Combined pixel by pixel: Σ (direct + indirect) x colour
   + emission + environment, on a scene with every kind of closure (diffuse,
-  glossy, glass, refraction, emission) and a visible world.
+  glossy, glass, refraction, emission, and a bump-mapped mix of diffuse and
+  glossy, where a sampled direction's value can differ from an evaluation's) and
+  a visible world.
 * Data passes: depth (planar), mist (each falloff), position, normal, UV,
   object and material index, colour passes, on a plane seen from above.
 * Cryptomatte: ids are MurmurHash3 of the names as floats, coverage sums to 1
@@ -50,14 +52,27 @@ def _glossy(rough):
                     surface=Link(0, "BSDF"))
 
 
+def _bumped_mix():
+    """Diffuse and rough glossy mixed, both bumped by a noise texture (strongly: the bumped
+    normals lean far from the smooth one)."""
+    return Material(name="bumped", nodes=[
+        ShaderNode("TexNoise", {"Scale": 8.0}),
+        ShaderNode("Bump", {"Height": Link(0, "Fac"), "Strength": 1.0, "Distance": 0.3}),
+        ShaderNode("BsdfDiffuse", {"Color": (0.8, 0.5, 0.3), "Normal": Link(1, "Normal")}),
+        ShaderNode("BsdfGlossy", {"Roughness": 0.4, "Normal": Link(1, "Normal")}),
+        ShaderNode("MixShader", {"Fac": 0.5, "Shader": Link(2, "BSDF"), "Shader_001": Link(3, "BSDF")})],
+        surface=Link(4, "Shader"))
+
+
 def _mixed_scene(samples=64, res=16, seed=0):
     """A floor (diffuse), spheres of rough glossy, glass and refraction, an emissive sphere,
-    a point light and a coloured world, seen in perspective."""
+    a bump-mapped one, a point light and a coloured world, seen in perspective."""
     parts, mats = [], []
     floor = Geometry.from_triangles(grid_plane(20.0, 2), material_index=np.zeros(8, int),
                                     object_names=["Floor"])
     parts.append(floor)
-    spheres = [((-1.2, 0, 0.6), 1), ((0.0, 0, 0.6), 2), ((1.2, 0, 0.6), 3), ((0.6, 1.2, 0.5), 4)]
+    spheres = [((-1.2, 0, 0.6), 1), ((0.0, 0, 0.6), 2), ((1.2, 0, 0.6), 3), ((0.6, 1.2, 0.5), 4),
+               ((-0.7, -1.0, 0.4), 5)]
     for k, (center, m) in enumerate(spheres):
         tris, norms = uv_sphere(0.5, 24, 12, center=center)
         parts.append(Geometry.from_triangles(tris, normals=norms, material_index=np.full(len(tris), m),
@@ -69,7 +84,8 @@ def _mixed_scene(samples=64, res=16, seed=0):
                                         ShaderNode("MixShader", {"Fac": 0.5, "Shader": Link(0, "BSDF"),
                                                                  "Shader_001": Link(1, "BSDF")})],
                      surface=Link(2, "Shader")),
-            Material(name="lamp", base_color=(0.0, 0.0, 0.0), emission=(4.0, 3.0, 2.0))]
+            Material(name="lamp", base_color=(0.0, 0.0, 0.0), emission=(4.0, 3.0, 2.0)),
+            _bumped_mix()]
     cam = translation(0.0, -5.0, 2.5) @ _rot_x(math.radians(65))
     return SceneDescription(
         geometry=Geometry.concatenate(parts), materials=mats,

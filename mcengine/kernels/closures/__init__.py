@@ -12,10 +12,10 @@ Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
   (closures whose label a light excludes add nothing to F but keep their pdf),
   pdf = Σ sw_k·pdf_k / Σ sw_k — one-sample MIS with the balance heuristic, the
   transparent closure counting in Σ sw_k only;
-* ``bsdf_sample``: picks closure k with probability sw_k / Σ sw_k, samples it
+* ``bsdf_sample_closure``: picks closure k with probability sw_k / Σ sw_k, samples it
   and returns the throughput weight F / pdf of the whole list (for a singular
-  lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes)
-  and the lobe's label.
+  lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes),
+  the lobe's label and k.
 
 Every closure whose normal differs from the point's smooth normal (a normal map,
 Bump Map Correction's lift of a glossy normal) carries Cycles' bump shadowing
@@ -224,22 +224,16 @@ def bsdf_eval(cl, n, wox, woy, woz, wix, wiy, wiz, exclude):
     return fr, fg, fb, (sum_pdf / sum_sw if sum_sw > 0.0 else 0.0)
 
 
-@device
-def bsdf_sample(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
-    """Sample the closure list: (wi world, weight r, g, b, pdf, label).
-
-    The weight is the path throughput factor F / pdf; pdf is the mixture pdf
-    (0 for a singular lobe, which other closures cannot produce).
-    """
-    wix, wiy, wiz, r, g, b, pdf, label, _ = bsdf_sample_closure(cl, n, wox, woy, woz, u_pick,
-                                                                u1, u2, u3)
-    return wix, wiy, wiz, r, g, b, pdf, label
-
-
 @function
 def bsdf_sample_closure(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
-    """:func:`bsdf_sample`, and the row of the closure sampled (-1: none): light tracing
-    needs a singular lobe's normal and index of refraction."""
+    """Sample the closure list: (wi world, weight r, g, b, pdf, label, the row of the
+    closure sampled (-1: none)).
+
+    The weight is the path throughput factor F / pdf; pdf is the mixture pdf
+    (0 for a singular lobe, which other closures cannot produce).  The row gives light
+    tracing a singular lobe's normal and index of refraction, and the light passes the
+    closure whose sampled value is part of F.
+    """
     total = 0.0
     for k in range(n):
         if cl[k, CL_TYPE] != CT_NONE:

@@ -37,7 +37,7 @@ from .kernels import passes as kp
 from .kernels.camera import camera_axes, view_plane
 
 __all__ = ["PassInfo", "PASSES", "CRYPTO_TYPES", "DENOISING_PASSES", "NOISY_IMAGE", "RenderPasses",
-           "Layout", "layout", "read", "MIST_FALLOFFS", "UNSUPPORTED", "SPLIT_DIFFERS",
+           "Layout", "layout", "read", "MIST_FALLOFFS", "UNSUPPORTED",
            "cryptomatte_metadata", "kernel_data", "world_to_camera", "world_to_raster",
            "motion_corners", "bytes_per_pixel"]
 
@@ -105,14 +105,6 @@ MIST_FALLOFFS = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
 UNSUPPORTED = {
     "Ambient Occlusion": "ambient occlusion is not computed (written as 0)",
 }
-
-# Light passes whose share of the light is not yet Cycles' (open: measured against Cycles at
-# 48x48, 128 spp, Glossy Direct 26 % low and Diffuse Indirect 11 % low on glass_mirror,
-# Transmission Indirect 44 % high on material_principled; tests/addon/test_passes_cycles.py).
-# Combined, the colour passes, Diffuse Direct and Emission agree, and the light passes still
-# add up to Combined.
-SPLIT_DIFFERS = ("Diffuse Indirect", "Glossy Direct", "Glossy Indirect", "Transmission Direct",
-                 "Transmission Indirect")
 
 
 @dataclass

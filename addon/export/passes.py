@@ -22,7 +22,6 @@ from mcengine.passes import (
     MIST_FALLOFFS,
     NOISY_IMAGE,
     PASSES,
-    SPLIT_DIFFERS,
     UNSUPPORTED,
     RenderPasses,
 )
@@ -92,11 +91,6 @@ def export_passes(ctx, scene, view_layer, integrator_name: str) -> RenderPasses:
     for name in passes.enabled:
         if name in UNSUPPORTED:
             ctx.warn(f"{name} pass: {UNSUPPORTED[name]}", f"{name} pass")
-    differ = [name for name in passes.enabled if name in SPLIT_DIFFERS]
-    if differ:
-        ctx.warn(f"{', '.join(differ)} pass{'es' if len(differ) > 1 else ''}: the split of light "
-                 f"between the diffuse, glossy and transmission passes is not yet Cycles' (they "
-                 f"still add up to Combined)", "light pass split")
     crl = getattr(view_layer, "cycles", None)
     others = [label for owner, prop, label in _OTHER_PASSES
               if getattr(crl if owner == "cycles" else view_layer, prop, False)]

@@ -15,9 +15,12 @@ cryptomatte_passes.h) decide what is written where:
   every such surface;
 * **light passes**: each contribution added to Combined also goes to
   Emission or Environment while the path has not scattered yet, else to the
-  diffuse, glossy and transmission passes in the proportions of the first
-  scattering event's BSDF (``pass weights``), direct at the first bounce and
-  indirect after;
+  diffuse, glossy and transmission passes, direct at the first bounce and
+  indirect after, in the shares each closure type has of the first bounce's
+  BSDF value (``pass weights``, ``split_eval``): in the light sample's
+  direction for its direct light, in the sampled direction for everything
+  that arrives through it (Cycles' bsdf_eval_pass_diffuse_weight and
+  _glossy_weight, kept in the path state from the first bounce on);
 * **denoising features**: at the first surface whose closures are not mostly
   specular (more than a quarter of the sample weight diffuse-like), the
   diffuse albedo times the product of the specular albedos before it, and

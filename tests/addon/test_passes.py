@@ -108,20 +108,6 @@ def test_unsupported_passes_are_warned_and_written_as_zero(scene, fake_session, 
             "written") in warnings
 
 
-def test_light_passes_not_split_as_cycles_are_warned(scene, fake_session):
-    layer = scene.view_layers[0]
-    layer.use_pass_diffuse_direct = layer.use_pass_glossy_direct = True
-    layer.use_pass_transmission_indirect = True
-    bpy.ops.render.render()
-    warnings = fake_session[-1].desc.warnings
-    assert ("Glossy Direct, Transmission Indirect passes: the split of light between the "
-            "diffuse, glossy and transmission passes is not yet Cycles' (they still add up to "
-            "Combined)") in warnings
-    layer.use_pass_glossy_direct = layer.use_pass_transmission_indirect = False
-    bpy.ops.render.render()
-    assert not any("split of light" in w for w in fake_session[-1].desc.warnings)
-
-
 @pytest.mark.parametrize("integrator", ["whitted", "light"])
 def test_other_integrators_say_they_fill_combined_only(scene, fake_session, integrator):
     """The classic integrators and Path + Light Tracing (whose caustics the light passes

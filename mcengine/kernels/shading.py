@@ -43,7 +43,6 @@ from .closures import (
     bsdf_eval,
     bsdf_sample_closure,
 )
-from .closures.layout import CL_NS
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
     PMF_EVERY,
@@ -86,7 +85,7 @@ from .state import (
     ST_NONFINITE,
 )
 from .surface import smooth_surface_offset, surface_point
-from .svm import ShadingData, eval_shader
+from .svm import BUMP_SET_NORMAL, OP_BUMP, ShadingData, eval_shader
 
 # Blender's default Shadow Terminator > Geometry Offset of an object: the cosine under which
 # shadow rays start from the smooth surface (``terminator_origin``).  Cycles reads it per
@@ -137,6 +136,21 @@ def set_ray(ray_o, ray_d, ray_tmax, o32, d32, t32, i, ox, oy, oz, dx, dy, dz, tm
     o32[i, 0], o32[i, 1], o32[i, 2] = ox, oy, oz
     d32[i, 0], d32[i, 1], d32[i, 2] = dx, dy, dz
     t32[i] = min(tmax, T_INFINITE)
+
+
+@device
+def shader_normal(sc, regs, sp):
+    """Cycles' sd->N at ``sp`` once its material's shader has run there: the normal a
+    displacement bump set (``BUMP_SET_NORMAL``, still in that material's registers), else
+    the interpolated shading normal.  A BSDF's own Normal input (a normal map) does not
+    change it."""
+    m = sc.mat_index[sp.prim]
+    start = sc.mat_prog[m, 0]
+    if start < sc.mat_prog[m, 1] and sc.svm_ops[start, 0] == OP_BUMP \
+            and sc.svm_ops[start, 1] == BUMP_SET_NORMAL:
+        b = sc.svm_ops[start, 2]
+        return regs[b], regs[b + 1], regs[b + 2]
+    return sp.nsx, sp.nsy, sp.nsz
 
 
 @device
@@ -421,6 +435,7 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     if pmf <= 0.0:
         return n_shadow
     bounce = depths[0]
+    nx, ny, nz = shader_normal(sc, scratch.regs, sp)     # before a light's shader runs
     if idx == sc.lamps.shape[0] + sc.emit_tri.shape[0]:
         ls = world_light_sample(sc, cfg, scratch, pmf, u1, u2)
     else:
@@ -445,8 +460,6 @@ def direct_light(sc, cfg, fcfg, stats, sq, n_shadow, out, row, beta, i, scratch,
     limit = fcfg[FCFG_CLAMP_DIRECT] if bounce == 0 else fcfg[FCFG_CLAMP_INDIRECT]
     cr, cg, cb = clamp_light(cr, cg, cb, limit, stats)
     if ls.cast_shadow:
-        nx, ny, nz = (scratch.cl[0, CL_NS], scratch.cl[0, CL_NS + 1], scratch.cl[0, CL_NS + 2]) if ncl > 0 \
-            else (sp.nsx, sp.nsy, sp.nsz)
         return push_shadow(sq, sc, n_shadow, row, sp, nx, ny, nz, ls.wix, ls.wiy, ls.wiz, ls.dist,
                            ls.lnx, ls.lny, ls.lnz, cr, cg, cb, transparent_left, depths)
     out[row, 0] += cr

@@ -38,26 +38,45 @@ CELL = 24                # pixels per case (a plane fills CELL - 2 of them)
 GAP = 0.25               # world units between planes (planes are 1 x 1)
 
 
-def _scene(cases: dict):
+def pixel_centre_scene(width: int, height: int):
+    """A new empty scene of ``width`` x ``height`` pixels that renders one ray through (about)
+    each pixel centre: 1 sample, seed 0, a Blackman-Harris filter 0.01 pixel wide (Box ignores
+    the width), no bounces, no denoising or adaptive sampling, the Standard view transform."""
     import bpy
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    n = len(cases)
-    cols = min(GRID, n)
-    rows = -(-n // cols)
-    pitch = 1.0 + GAP
-    scene.render.resolution_x = cols * CELL
-    scene.render.resolution_y = rows * CELL
+    scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
     scene.cycles.filter_width = 0.01
+    scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"
     scene.view_settings.view_transform = "Standard"
-    scene.cycles.samples = 1         # one ray through (about) each pixel centre
+    scene.cycles.samples = 1
     scene.cycles.use_denoising = False
     scene.cycles.use_adaptive_sampling = False
     scene.cycles.seed = 0
     scene.cycles.max_bounces = 0
-    scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"    # Box ignores the width
+    return scene
+
+
+def black_world(scene) -> None:
+    """A world whose Background is black."""
+    import bpy
+
+    world = bpy.data.worlds.new("black")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+    scene.world = world
+
+
+def _scene(cases: dict):
+    import bpy
+
+    n = len(cases)
+    cols = min(GRID, n)
+    rows = -(-n // cols)
+    pitch = 1.0 + GAP
+    scene = pixel_centre_scene(cols * CELL, rows * CELL)
     cam_data = bpy.data.cameras.new("cam")
     cam_data.type = "ORTHO"
     cam_data.ortho_scale = pitch * max(cols, rows)
@@ -66,10 +85,7 @@ def _scene(cases: dict):
     cam.location = (pitch * (cols - 1) / 2, -pitch * (rows - 1) / 2, 10.0)
     scene.collection.objects.link(cam)
     scene.camera = cam
-    world = bpy.data.worlds.new("black")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
-    scene.world = world
+    black_world(scene)
     for k, (name, case) in enumerate(cases.items()):
         build, prepare = case if isinstance(case, tuple) else (case, None)
         r, c = divmod(k, cols)

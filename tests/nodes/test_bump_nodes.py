@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from .harness import assert_agree, render_cases
+from .harness import assert_agree, black_world, pixel_centre_scene, render_cases
 
 
 def _noise(nt, scale=4.0, coord=None):
@@ -244,28 +244,14 @@ def _lit_spheres():
     one sample at each pixel centre: every pixel is the sun's light through one shadow ray."""
     import bpy
 
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.resolution_x, scene.render.resolution_y = 48, 144
-    scene.render.resolution_percentage = 100
-    scene.cycles.filter_width = 0.01
-    scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"
-    scene.view_settings.view_transform = "Standard"
-    scene.cycles.samples = 1
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.seed = 0
-    scene.cycles.max_bounces = 0
+    scene = pixel_centre_scene(48, 144)
     cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
     cam.data.type = "ORTHO"
     cam.data.ortho_scale = 7.2
     cam.location, cam.rotation_euler = (0.0, -10.0, 0.0), (math.pi / 2, 0.0, 0.0)
     scene.collection.objects.link(cam)
     scene.camera = cam
-    world = bpy.data.worlds.new("black")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
-    scene.world = world
+    black_world(scene)
     sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
     sun.data.energy, sun.data.angle = 3.0, 0.0
     sun.rotation_euler = (0.0, math.pi / 2 - 0.05, 0.0)

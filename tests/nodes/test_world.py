@@ -9,7 +9,7 @@ except where a pixel centre falls on a texel boundary (Closest).
 import numpy as np
 import pytest
 
-from .harness import assert_agree, render_both
+from .harness import assert_agree, pixel_centre_scene, render_both
 
 
 def _env_image(name="sky", size=(32, 16), seed=11):
@@ -28,16 +28,7 @@ def _env_image(name="sky", size=(32, 16), seed=11):
 
 def _scene():
     import bpy
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.resolution_x, scene.render.resolution_y = 48, 32
-    scene.render.resolution_percentage = 100
-    scene.cycles.filter_width = 0.01
-    scene.view_settings.view_transform = "Standard"
-    scene.cycles.samples = 1
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.max_bounces = 0
+    scene = pixel_centre_scene(48, 32)
     cam_data = bpy.data.cameras.new("cam")
     cam_data.lens = 9.0
     cam = bpy.data.objects.new("cam", cam_data)

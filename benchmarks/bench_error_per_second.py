@@ -165,13 +165,16 @@ def table_markdown(rows, args, options, elapsed) -> str:
     out.write("| --- | --- | --- | --- | --- | --- | --- | --- |\n")
     for row in rows:
         if "time_ratio" not in row:
-            out.write(f"| {row['scene']} | {row['note']} | | | | | | |\n")
+            out.write(f"| {row['scene']} | {row['note'].split(':')[0]} (below) | | | | | | |\n")
             continue
         out.write(f"| {row['scene']} | {row['target_relmse']:.3g} | {row['mc_seconds']:.2f} s "
                   f"| {row['cycles_seconds']:.2f} s | {ratio_text(row)} "
                   f"| {row['mc_efficiency']:.3g} | {row['cycles_efficiency']:.3g} "
                   f"| {row['efficiency_ratio']:.2f} |\n")
     out.write("\n" + medians_text(rows) + "\n")
+    for row in rows:
+        if "time_ratio" not in row:
+            out.write(f"\n{row['scene']}: {row['note']}.\n")
     measured = [r for r in rows if "load" in r]
     if measured:
         loads = [r["load"] for r in measured]

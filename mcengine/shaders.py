@@ -47,7 +47,13 @@ import numpy as np
 
 from .kernels.camera import CAMERA_PARAMS
 from .kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
-from .kernels.state import MF_BUMP_CORRECTION, MF_EMISSION_VARIES, MF_EMISSIVE, MF_TRANSPARENT
+from .kernels.state import (
+    MF_BUMP_CORRECTION,
+    MF_CLOSURES_ONLY,
+    MF_EMISSION_VARIES,
+    MF_EMISSIVE,
+    MF_TRANSPARENT,
+)
 from .kernels.svm import (
     BUMP_DX,
     BUMP_DY,
@@ -68,6 +74,7 @@ from .kernels.svm import (
     RGB_TO_Y,
     ShadingData,
     TextureData,
+    closures_only,
     eval_node,
     eval_shader,
 )
@@ -507,6 +514,8 @@ class ShaderTable:
                 flags |= MF_EMISSIVE
             if program.emission_varies:
                 flags |= MF_EMISSION_VARIES
+            if closures_only(self.ops[self.ranges[i, 0]:self.ranges[i, 1]]):
+                flags |= MF_CLOSURES_ONLY
             if m.use_transparent_shadow and (max(res.tr, res.tg, res.tb) > 0.0
                                              or program.transparency_varies):
                 flags |= MF_TRANSPARENT

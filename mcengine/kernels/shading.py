@@ -70,6 +70,7 @@ from .state import (
     FCFG_WORLD_IMPORTANCE,
     FCFG_WORLD_PMF,
     MF_BUMP_CORRECTION,
+    MF_CLOSURES_ONLY,
     MF_EMISSION_VARIES,
     PF_CAMERA,
     PF_DIFFUSE,
@@ -85,7 +86,7 @@ from .state import (
     ST_NONFINITE,
 )
 from .surface import smooth_surface_offset, surface_point
-from .svm import BUMP_SET_NORMAL, OP_BUMP, ShadingData, eval_shader
+from .svm import BUMP_SET_NORMAL, OP_BUMP, ShadingData, eval_closure_rows, eval_shader
 
 # Blender's default Shadow Terminator > Geometry Offset of an object: the cosine under which
 # shadow rays start from the smooth surface (``terminator_origin``).  Cycles reads it per
@@ -349,6 +350,9 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
                       cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
                       (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
                       p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths, footprint)
+    if sc.mat_flags[m] & MF_CLOSURES_ONLY:
+        return eval_closure_rows(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
+                                 scratch.cl, sd)
     return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
                        sd, sc.tex, sc.verts, sc.tris)
 

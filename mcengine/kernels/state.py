@@ -101,6 +101,7 @@ MF_EMISSIVE = 1           # emits light: its triangles are lights for next-event
 MF_TRANSPARENT = 2        # has transparent closures and lets shadow rays through them
 MF_BUMP_CORRECTION = 4    # Cycles' use_bump_map_correction
 MF_EMISSION_VARIES = 8    # its emission depends on the point (textures): light samples run its shader
+MF_CLOSURES_ONLY = 16     # its program is closure rows on constant inputs (svm.closures_only)
 
 # Path flags.
 PF_CAMERA = 1            # no scattering yet: the ray is a camera ray

@@ -107,7 +107,7 @@ _G_GAMMA = OFFSETS["Gamma"]["Gamma"]
 
 
 @function
-def eval_color_node(code, regs, b, c, sd, tex):
+def eval_color_node(code, regs, b, c):
     if code == _MIX:
         mix_node(regs, b, c)
     elif code == _MIX_RGB:

@@ -101,7 +101,7 @@ _INT_MIN = -2147483648.0
 
 
 @function
-def eval_math_node(code, regs, b, c, sd, tex):
+def eval_math_node(code, regs, b, c):
     if code == _MATH:
         r = math_op(int(regs[b + _M_OP]), regs[b], regs[b + _M_B], regs[b + _M_C])
         if regs[b + _M_CLAMP] != 0.0:

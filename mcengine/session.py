@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import accel_cache, memory
+from . import accel_cache, blas, memory
 from . import passes as render_passes
 from .adaptive import Adaptive
 from .denoise import denoise
@@ -248,6 +248,7 @@ class RenderSession:
     def __init__(self, scene: SceneDescription, *, threads: int | None = None,
                  batch_size: int | None = None, host_bytes_per_pixel: int = 0,
                  force_effects=()):
+        blas.use_one_thread()          # numpy's small matrix calls: microseconds, not ms
         self.scene = scene.validate()
         self.threads = int(threads or default_threads())
         self.batch_size = int(batch_size or DEFAULT_BATCH)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mcengine import blas
 from mcengine.kernels.camera import view_plane
 from mcengine.scene import MotionVectors, SceneDescription, SceneError
 
@@ -106,6 +107,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     from . import camera as cameras
     from . import motion, passes, settings, world
 
+    blas.use_one_thread()      # the export's 4 x 4 inverses: microseconds, not ms (mcengine.blas)
     scene = depsgraph.scene
     if frame_set is None:
         def frame_set(frame, subframe):

@@ -21,9 +21,11 @@ from mcengine.scene import (
     Geometry,
     Integrator,
     Light,
+    Link,
     Material,
     SceneDescription,
     SceneError,
+    ShaderNode,
     World,
 )
 from mcengine.session import RenderSession
@@ -129,6 +131,36 @@ def test_too_wide_a_ray_tree_is_a_clear_error():
     scene.integrator.branching, scene.integrator.depth = 64, 5
     with pytest.raises(SceneError, match="exceed the batch"):
         RenderSession(scene)
+
+
+ALL_SMOOTH = {"Roughness": 0.0, "Metallic": 0.5, "Transmission Weight": 0.5, "Coat Weight": 0.5,
+              "Coat Roughness": 0.0, "Alpha": 0.5}
+
+
+@pytest.mark.parametrize("inputs,width", [
+    ({}, 2),                       # the default Principled BSDF is rough: it spawns no ray
+    ({"Roughness": 0.0}, 2),       # its smooth specular: one mirror ray (the tree stays binary)
+    ({"Alpha": 0.3}, 2),           # one ray through its transparency
+    (ALL_SMOOTH, 6),               # coat, metallic, specular, glass (2) and alpha
+    ("textured", 6),               # roughness from a texture: the most the node can spawn
+])
+def test_whitted_chunks_are_sized_by_the_rays_the_materials_can_spawn(inputs, width):
+    """A chunk holds batch / width^(depth - 1) camera rays, width the most rays one hit
+    spawns: counted from a constant material's inputs (a rough one spawns none), else the
+    node's most. Counting six for the default Principled BSDF made chunks of depth 5 hold
+    101 camera rays and Whitted's time grow with the square of the samples."""
+    if inputs == "textured":
+        nodes = [ShaderNode("TexChecker"), ShaderNode("BsdfPrincipled", {"Roughness": Link(0, "Fac")})]
+    else:
+        nodes = [ShaderNode("BsdfPrincipled", inputs)]
+    scene = inside_sphere_scene(samples=1, res=4)
+    scene.materials = [Material(nodes=nodes, surface=Link(len(nodes) - 1, "BSDF"))]
+    scene.integrator.name, scene.integrator.depth = "whitted", 5
+    session = RenderSession(scene)
+    assert session.roots_per_chunk == session.batch_size // width ** 4
+    if inputs == ALL_SMOOTH:      # the tree of the widest case fits: it renders
+        scene.integrator.depth = 3
+        assert np.isfinite(RenderSession(scene).run().image()).all()
 
 
 def test_kernel_codes_agree_with_the_registry():

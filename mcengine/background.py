@@ -13,8 +13,13 @@ over directions (a constant world is found by BSDF rays alone, as before).
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+
+from .kernels.background import bake_background
+from .kernels.state import alloc_scratch
 
 DEFAULT_MAP = (1024, 512)     # Automatic, without an Environment Texture
 
@@ -32,6 +37,22 @@ def map_size(world, images: dict) -> tuple[int, int] | None:
         return DEFAULT_MAP
     h, w = max(sizes, key=lambda s: s[0] * s[1])
     return int(w), int(h)
+
+
+def bake_world(sc, cfg, out) -> None:
+    """Bake the world's radiance into ``out`` (H, W, 3) for its importance map, in bands of
+    rows on as many threads as there are cores (the kernel releases the GIL; each band has
+    its own shader registers): world_hdri_sun's map took 86 ms on one thread, 46 ms on two."""
+    h = out.shape[0]
+    bands = max(1, min(os.cpu_count() or 1, h))
+    edges = [h * k // bands for k in range(bands + 1)]
+    if bands == 1:
+        bake_background(sc, cfg, alloc_scratch(sc), out, 0, h)
+        return
+    with ThreadPoolExecutor(max_workers=bands, thread_name_prefix="mcengine-bake") as pool:
+        for done in [pool.submit(bake_background, sc, cfg, alloc_scratch(sc), out, edges[k],
+                                 edges[k + 1]) for k in range(bands)]:
+            done.result()
 
 
 def importance_map(radiance: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

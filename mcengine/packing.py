@@ -16,11 +16,10 @@ from typing import NamedTuple
 import numpy as np
 
 from . import cryptomatte, integrators, samplers
-from .background import importance_map, map_size
+from .background import bake_world, importance_map, map_size
 from .features import EffectsPlan, lamps_intersectable
 from .features import detect as detect_plan
 from .images import ImageTable
-from .kernels.background import bake_background
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
@@ -152,7 +151,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         bake_cfg = np.zeros(CFG_SIZE, np.int64)
         bake_cfg[CFG_WORLD_SHADER] = 1
         baked = np.zeros((size[1], size[0], 3))
-        bake_background(sc, bake_cfg, alloc_scratch(sc), baked)
+        bake_world(sc, bake_cfg, baked)
         marginal, conditional, mean = importance_map(baked)
         if mean > 0.0:
             sc = sc._replace(bg_marginal=marginal, bg_conditional=conditional)

@@ -59,10 +59,11 @@ def equirectangular_direction(u, v):
 
 
 @kernel
-def bake_background(sc, cfg, scratch, out):
-    """The world's radiance at the centre of each texel of ``out`` (H, W, 3)."""
+def bake_background(sc, cfg, scratch, out, y0, y1):
+    """The world's radiance at the centre of each texel of rows [y0, y1) of ``out`` (H, W, 3)
+    (threads bake bands of rows, each with its own ``scratch``)."""
     h, w = out.shape[0], out.shape[1]
-    for y in range(h):
+    for y in range(y0, y1):
         for x in range(w):
             dx, dy, dz = equirectangular_direction((x + 0.5) / w, (y + 0.5) / h)
             r, g, b = world_radiance(sc, cfg, scratch, dx, dy, dz, 0)

@@ -133,3 +133,23 @@ def test_importance_sampling_lowers_the_noise(renders):
     ratio = (se_uniform ** 2 * 16384) / (se_map ** 2 * 1024)
     print(f"variance ratio per sample, BSDF sampling / importance map: {ratio:.0f}")
     assert ratio > 300.0
+
+
+def test_the_map_baked_in_bands_of_rows_is_the_map_baked_in_one(monkeypatch):
+    """``bake_world`` splits the rows among threads, each with its own shader registers: the
+    map is the one a single band bakes, texel for texel (and the sun is in it)."""
+    import mcengine.background as background
+    from mcengine.kernels.state import CFG_SIZE, CFG_WORLD_SHADER, alloc_scratch
+    from mcengine.packing import pack_scene
+
+    sc = pack_scene(hdri_scene("MANUAL", 1)).sc
+    cfg = np.zeros(CFG_SIZE, np.int64)
+    cfg[CFG_WORLD_SHADER] = 1
+    one = np.zeros((H, W, 3))
+    background.bake_background(sc, cfg, alloc_scratch(sc), one, 0, H)
+    for cores in (2, 3, 7):
+        monkeypatch.setattr(background.os, "cpu_count", lambda cores=cores: cores)
+        banded = np.full((H, W, 3), np.nan)
+        background.bake_world(sc, cfg, banded)
+        np.testing.assert_array_equal(banded, one)
+    assert one.max() > 0.5 * SUN

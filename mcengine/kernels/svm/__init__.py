@@ -99,6 +99,7 @@ ShaderResult = namedtuple("ShaderResult", [
     "tr", "tg", "tb",          # transparency: the summed weight of transparent closures
     "holdout",                 # holdout weight (the film's alpha is reduced by it)
 ])
+NO_RESULT = ShaderResult(np.int64(0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # before any row
 
 
 @device
@@ -170,10 +171,7 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
     """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`.
     ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point
     (not in ``tex``: every node function takes that, and a call copies its arrays)."""
-    n = 0
-    er = eg = eb = 0.0
-    tr = tg = tb = 0.0
-    holdout = 0.0
+    res = NO_RESULT
     if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:
         surface, b = start + ops[start, 3], ops[start, 2]
         eval_values(ops, start + 1, surface, regs, sd, tex, verts, tris)
@@ -185,38 +183,34 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
             continue
         op = ops[pc, 0]
         if op == OP_CLOSURE or op == OP_MIX_WEIGHT:
-            n, der, deg, deb, dtr, dtg, dtb, dh = closure_row(ops, pc, regs, cl, n, sd)
-            er += der
-            eg += deg
-            eb += deb
-            tr += dtr
-            tg += dtg
-            tb += dtb
-            holdout += dh
+            res = closure_row(ops, pc, regs, cl, sd, res)
         elif op == OP_BUMP:
             eval_values(ops, pc + 1, pc + ops[pc, 3], regs,
                         bump_point(sd, verts, tris, regs[ops[pc, 2]], ops[pc, 1]), tex, verts, tris)
             skip = pc + ops[pc, 3] + 1
         else:
             eval_row(ops, pc, regs, sd, tex)
-    return ShaderResult(n, er, eg, eb, tr, tg, tb, holdout)
+    return res
 
 
 @device
-def closure_row(ops, pc, regs, cl, n, sd):
-    """Run row pc, an ``OP_CLOSURE`` or ``OP_MIX_WEIGHT``; returns (n, emission RGB,
-    transparency RGB, holdout) with n the closures in cl after it."""
+def closure_row(ops, pc, regs, cl, sd, res):
+    """Run row pc, an ``OP_CLOSURE`` or ``OP_MIX_WEIGHT``, after the rows that gave ``res``;
+    returns the :class:`ShaderResult` with this row's closures and light added."""
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if ops[pc, 0] == OP_MIX_WEIGHT:
         fac = min(max(regs[a], 0.0), 1.0)
         w = regs[b] if b >= 0 else 1.0
         regs[c] = w * (1.0 - fac)
         regs[c + 1] = w * fac
-        return n, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return res
     w = regs[c] if c >= 0 else 1.0
     if w == 0.0:
-        return n, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    return eval_closure_node(np.int64(a), regs, np.int64(b), w, cl, np.int64(n), sd)
+        return res
+    n, er, eg, eb, tr, tg, tb, h = eval_closure_node(np.int64(a), regs, np.int64(b), w, cl,
+                                                     np.int64(res.n), sd)
+    return ShaderResult(n, res.er + er, res.eg + eg, res.eb + eb, res.tr + tr, res.tg + tg,
+                        res.tb + tb, res.holdout + h)
 
 
 @device
@@ -224,20 +218,10 @@ def eval_closure_rows(ops, start, end, regs, cl, sd):
     """``eval_shader`` for a program of closure and mix-weight rows only (``closures_only``):
     the same result, without taking the texture data and the triangles, which a call copies
     (about 90 machine words, a tenth of the render time of a constant material)."""
-    n = 0
-    er = eg = eb = 0.0
-    tr = tg = tb = 0.0
-    holdout = 0.0
+    res = NO_RESULT
     for pc in range(start, end):
-        n, der, deg, deb, dtr, dtg, dtb, dh = closure_row(ops, pc, regs, cl, n, sd)
-        er += der
-        eg += deg
-        eb += deb
-        tr += dtr
-        tg += dtg
-        tb += dtb
-        holdout += dh
-    return ShaderResult(n, er, eg, eb, tr, tg, tb, holdout)
+        res = closure_row(ops, pc, regs, cl, sd, res)
+    return res
 
 
 def closures_only(rows) -> bool:

@@ -9,19 +9,38 @@ mean of |R|, |G|, |B| times the sine of its row's polar angle; rows become CDFs
 over their columns and the rows one CDF (a row of zero weight is sampled
 uniformly).  MC Engine samples the world this way only when its radiance varies
 over directions (a constant world is found by BSDF rays alone, as before).
+
+The last map is kept for the next render whose world bakes from the same inputs
+(``world_map``): re-renders, animation frames and the viewport's restarts
+after a camera or material edit skip the bake, as they skip the BVH build
+(``accel_cache``).  The inputs are recognised by a hash (BLAKE2b, about 1 ms per
+MB) of the world's program, its registers, the images its nodes read and the map's
+size (the camera and the objects only when one of the world's nodes can see them).
+A map kept by mistake could only change the noise, never the mean: the
+renderer samples the world from the map it holds and weighs by that map's pdf.
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
 from .kernels.background import bake_background
-from .kernels.state import alloc_scratch
+from .kernels.state import CFG_SIZE, CFG_WORLD_SHADER, alloc_scratch
+from .kernels.svm.data import IMG_CHANNELS, IMG_FLOAT, IMG_HEIGHT, IMG_OFFSET, IMG_WIDTH
 
 DEFAULT_MAP = (1024, 512)     # Automatic, without an Environment Texture
+
+_lock = threading.Lock()
+_last: tuple[bytes, tuple] | None = None    # (hash of the bake's inputs, importance_map's result)
+# World nodes whose outputs can depend on the camera or on objects (Texture Coordinate's
+# Camera, Window and Object, Camera Data, Vector Transform): with one of them the camera
+# and the objects are inputs of the bake.
+_VIEW_NODES = frozenset({"TexCoord", "CameraData", "VectorTransform"})
 
 
 def map_size(world, images: dict) -> tuple[int, int] | None:
@@ -37,6 +56,57 @@ def map_size(world, images: dict) -> tuple[int, int] | None:
         return DEFAULT_MAP
     h, w = max(sizes, key=lambda s: s[0] * s[1])
     return int(w), int(h)
+
+
+def world_map(sc, world, slots: dict, registers, size) -> tuple[np.ndarray, np.ndarray, float]:
+    """The importance map (``importance_map``) of the world ``world`` (the scene
+    description's) at ``size`` (W, H): baked from the packed scene ``sc``, whose world
+    program's registers are [registers[0], registers[1]) of ``sc.svm_regs`` and whose
+    images sit in ``slots`` (``images.ImageTable.slots``); or the last render's map when
+    the bake's inputs are the same."""
+    global _last
+    key = _digest(sc, world, slots, registers, size)
+    with _lock:
+        if _last is not None and _last[0] == key:
+            return _last[1]
+        _last = None               # free the old map before baking the new one
+    cfg = np.zeros(CFG_SIZE, np.int64)
+    cfg[CFG_WORLD_SHADER] = 1
+    baked = np.zeros((size[1], size[0], 3))
+    bake_world(sc, cfg, baked)
+    result = importance_map(baked)
+    with _lock:
+        _last = (key, result)
+    return result
+
+
+def clear() -> None:
+    """Forget the kept importance map."""
+    global _last
+    with _lock:
+        _last = None
+
+
+def _digest(sc, world, slots, registers, size) -> bytes:
+    """A hash of what the bake reads: the world's program and registers, the texels of the
+    images its nodes name, the camera and the objects if a node can see them, the size."""
+    w = sc.mat_prog.shape[0] - 1              # the world's program is the last
+    parts = [np.asarray(size, np.int64), sc.svm_ops[sc.mat_prog[w, 0]:sc.mat_prog[w, 1]],
+             sc.svm_regs[int(registers[0]):int(registers[1])], sc.world]
+    if any(n.type in _VIEW_NODES for n in world.nodes):
+        parts += [sc.camera, sc.tex.objects]
+    for name in sorted({str(n.props.get("image", "")) for n in world.nodes} & set(slots)):
+        row = sc.tex.images[slots[name]]
+        pool = sc.tex.pixf if row[IMG_FLOAT] else sc.tex.pix8
+        count = int(row[IMG_WIDTH] * row[IMG_HEIGHT] * row[IMG_CHANNELS])
+        parts += [row, pool[row[IMG_OFFSET]:row[IMG_OFFSET] + count]]
+    h = hashlib.blake2b(digest_size=32)
+    for array in parts:
+        array = np.ascontiguousarray(array)
+        h.update(f"{array.dtype}{array.shape}".encode())
+        if array.size:
+            h.update(memoryview(array).cast("B"))
+    return h.digest()
 
 
 def bake_world(sc, cfg, out) -> None:

@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import cryptomatte, integrators, samplers
-from .background import bake_world, importance_map, map_size
+from .background import map_size, world_map
 from .features import EffectsPlan, lamps_intersectable
 from .features import detect as detect_plan
 from .images import ImageTable
@@ -148,11 +148,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     world_importance = world_power = 0.0
     size = map_size(scene.world, scene.images) if world_varies else None
     if size is not None:
-        bake_cfg = np.zeros(CFG_SIZE, np.int64)
-        bake_cfg[CFG_WORLD_SHADER] = 1
-        baked = np.zeros((size[1], size[0], 3))
-        bake_world(sc, bake_cfg, baked)
-        marginal, conditional, mean = importance_map(baked)
+        marginal, conditional, mean = world_map(sc, scene.world, images.slots,
+                                                shaders.register_ranges[world], size)
         if mean > 0.0:
             sc = sc._replace(bg_marginal=marginal, bg_conditional=conditional)
             world_importance = math.pi * mean                     # irradiance, as a sun's

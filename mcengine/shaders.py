@@ -474,9 +474,10 @@ class ShaderTable:
     of each material before shading it.
 
     ``ops`` (P, 4) int32 holds the programs, ``ranges`` (M, 2) int32 the
-    [start, end) row range of material m's, and ``registers`` (R,) float64 the
+    [start, end) row range of material m's, ``registers`` (R,) float64 the
     register file with every material's constants in place (each worker
-    copies it once per render).  ``emission`` (M, 3) is the radiance the
+    copies it once per render) and ``register_ranges`` (M, 2) the [start, end)
+    of material m's registers in it.  ``emission`` (M, 3) is the radiance the
     material emits as a light source, evaluated as Cycles evaluates a light's
     shader (no closures built, so no layer above the emission darkens it;
     facing the normal), and ``flags`` (M,) holds MF_* bits: emissive,
@@ -485,11 +486,12 @@ class ShaderTable:
 
     def __init__(self, materials, attributes: AttributeLayout | None = None,
                  images: dict | None = None):
-        ops, ranges, init = [], [], {}
+        ops, ranges, register_ranges, init = [], [], [], {}
         programs = []
         base = 0
         for m in materials:
             program = compile_material(m, attributes, base, images)
+            register_ranges.append([base, base + program.registers])
             base += program.registers
             ranges.append([len(ops), len(ops) + len(program.ops)])
             ops.extend(program.ops)
@@ -497,6 +499,7 @@ class ShaderTable:
             programs.append(program)
         self.ops = np.array(ops, np.int32).reshape(-1, 4)
         self.ranges = np.array(ranges, np.int32).reshape(-1, 2)
+        self.register_ranges = np.array(register_ranges, np.int64).reshape(-1, 2)
         self.registers = np.zeros(max(base, 1))
         if init:
             self.registers[np.fromiter(init.keys(), np.int64)] = np.fromiter(init.values(), float)

@@ -153,3 +153,56 @@ def test_the_map_baked_in_bands_of_rows_is_the_map_baked_in_one(monkeypatch):
         background.bake_world(sc, cfg, banded)
         np.testing.assert_array_equal(banded, one)
     assert one.max() > 0.5 * SUN
+
+
+def test_the_map_is_kept_while_the_bake_reads_the_same(monkeypatch):
+    """``background.world_map`` bakes once for renders of the same world (another material
+    does not matter) and again when the world's strength, its image's texels, the map size
+    or, for a world that reads the camera, the camera change."""
+    import dataclasses
+
+    import mcengine.background as background
+    from mcengine.kernels.state import FCFG_WORLD_IMPORTANCE
+    from mcengine.packing import pack_scene
+
+    bakes = []
+    real = background.bake_world
+    monkeypatch.setattr(background, "bake_world", lambda *a: (bakes.append(1), real(*a)))
+    background.clear()
+    scene = hdri_scene("MANUAL", 1)
+    first = pack_scene(scene)
+    again = pack_scene(scene)
+    assert len(bakes) == 1 and again.sc.bg_conditional is first.sc.bg_conditional
+    pack_scene(dataclasses.replace(scene, materials=[Material(base_color=(0.3, 0.5, 0.7))]))
+    moved = dataclasses.replace(scene.camera, matrix_world=look_down(7.0))
+    pack_scene(dataclasses.replace(scene, camera=moved))
+    assert len(bakes) == 1
+
+    def world(strength=1.0, resolution=512, vector=None):
+        env = ShaderNode("TexEnvironment", {} if vector is None else {"Vector": vector},
+                         props={"image": "sky"})
+        nodes = [env, ShaderNode("Background", {"Color": Link(0, "Color"), "Strength": strength})]
+        if vector is not None:
+            nodes.append(ShaderNode("TexCoord"))
+        return World(nodes=nodes, surface=Link(1, "Background"), sampling="MANUAL",
+                     map_resolution=resolution)
+
+    brighter = pack_scene(dataclasses.replace(scene, world=world(strength=2.0)))
+    assert len(bakes) == 2
+    assert brighter.fcfg[FCFG_WORLD_IMPORTANCE] == pytest.approx(2 * first.fcfg[FCFG_WORLD_IMPORTANCE])
+    pack_scene(scene)                                       # (each change from the first)
+    sky = small_sun_hdri()
+    sky[:, :, :3] = np.roll(sky[:, :, :3], 16, axis=1)      # the sun a quarter turn on
+    turned = pack_scene(dataclasses.replace(scene, images={"sky": Image(sky, "linear", "PREMUL")}))
+    assert len(bakes) == 4
+    assert not np.array_equal(turned.sc.bg_conditional, first.sc.bg_conditional)
+    pack_scene(scene)
+    coarser = pack_scene(dataclasses.replace(scene, world=world(resolution=256)))
+    assert len(bakes) == 6 and coarser.sc.bg_conditional.shape == (128, 257)
+    # A world that reads the camera's coordinates is baked again when the camera moves.
+    camera_world = dataclasses.replace(scene, world=world(vector=Link(2, "Camera")))
+    pack_scene(camera_world)
+    pack_scene(camera_world)
+    assert len(bakes) == 7
+    pack_scene(dataclasses.replace(camera_world, camera=moved))
+    assert len(bakes) == 8

@@ -407,7 +407,7 @@ class _Compiler:
         """Evaluate a pure node with constant inputs now, with the kernels' own code."""
         regs = np.concatenate([np.asarray(v.const, float) for v in values] + [np.zeros(64)])
         out = sum(len(v.const) for v in values)
-        eval_node(spec.code, regs, 0, out, _HOST_POINT, _NO_TEXTURES)
+        eval_node(spec.code, regs, 0, out, _HOST_POINT, NO_TEXTURES)
         outputs, k = {}, out
         for socket in spec.outputs:
             n = SIZE[socket.type]
@@ -458,15 +458,16 @@ _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map
                       "VertexColor": ("", "layer_name"), "NormalMap": (TANGENT_PREFIX, "uv_map")}
 
 
-# What the compiler shows a node it evaluates ahead of time: no point, no scene.
+# What the compiler shows a node it evaluates ahead of time: no point, no scene (and, public,
+# what a program run on the host without a scene reads: tests/core/test_closure_rows.py).
 _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
                           False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0.0)
-_NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
-                           tri_object=np.zeros(0, np.int32),
-                           objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
-                           images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
-                           pixf=np.zeros(0, np.float32))
-_NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32))     # verts, tris (SceneData's types)
+NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
+                          tri_object=np.zeros(0, np.int32),
+                          objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
+                          images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
+                          pixf=np.zeros(0, np.float32))
+NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32))     # verts, tris (SceneData's types)
 
 
 class ShaderTable:
@@ -510,7 +511,7 @@ class ShaderTable:
         for i, (m, program) in enumerate(zip(materials, programs)):
             point = point._replace(bump_correction=m.use_bump_map_correction)
             res = eval_shader(self.ops, self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
-                              _NO_TEXTURES, *_NO_MESH)
+                              NO_TEXTURES, *NO_MESH)
             self.emission[i] = np.maximum((res.er, res.eg, res.eb), 0.0)
             flags = MF_BUMP_CORRECTION if m.use_bump_map_correction else 0
             if self.emission[i].max() > 0.0 or program.emission_varies:

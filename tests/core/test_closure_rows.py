@@ -15,7 +15,7 @@ from mcengine.kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
 from mcengine.kernels.state import MF_CLOSURES_ONLY
 from mcengine.kernels.svm import ShadingData, eval_closure_rows, eval_shader
 from mcengine.scene import Link, Material, ShaderNode
-from mcengine.shaders import _NO_MESH, _NO_TEXTURES, ShaderTable
+from mcengine.shaders import NO_MESH, NO_TEXTURES, ShaderTable
 
 CONSTANT = {
     "principled": Material(nodes=[ShaderNode("BsdfPrincipled", {"Base Color": (0.7, 0.3, 0.2)})],
@@ -83,7 +83,7 @@ def test_closure_rows_give_what_the_shader_gives(table):
         for sd in _points(25):
             regs_a, regs_b = table.registers.copy(), table.registers.copy()
             cl_a, cl_b = np.zeros((MAX_CLOSURES, CL_STRIDE)), np.zeros((MAX_CLOSURES, CL_STRIDE))
-            a = eval_shader(table.ops, start, end, regs_a, cl_a, sd, _NO_TEXTURES, *_NO_MESH)
+            a = eval_shader(table.ops, start, end, regs_a, cl_a, sd, NO_TEXTURES, *NO_MESH)
             b = eval_closure_rows(table.ops, start, end, regs_b, cl_b, sd)
             assert tuple(a) == tuple(b), name
             assert a.n > 0 or name == "add with holdout", name

@@ -18,10 +18,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ...jit import device, function
 from .hash import hash_float, hash_float2, hash_uint, hash_uint2, hash_uint3, hash_uint4, r32
+from .math_nodes import fmod
 from .nodes import (
     NOISE_FBM,
     NOISE_HETERO_TERRAIN,
@@ -149,7 +148,7 @@ def _wrap(p):
     The coordinate is Cycles' float32 one: beyond 1e6 its spacing (0.06-0.25) is
     what the pattern shows."""
     p = r32(p)
-    return np.fmod(p, 100000.0) + (0.5 if abs(p) >= 1000000.0 else 0.0)
+    return fmod(p, 100000.0) + (0.5 if abs(p) >= 1000000.0 else 0.0)
 
 
 @device

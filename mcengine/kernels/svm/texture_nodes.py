@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ...jit import device, function
 from .hash import hash_float, hash_float2, hash_float3, hash_float4, r32
+from .math_nodes import fmod
 from .nodes import NODES, OFFSETS, OUTPUT_OFFSETS
 from .noise import noise_fbm, noise_texture
 from .voronoi import voronoi_texture
@@ -316,9 +315,9 @@ def magic_node(regs, b, c):
     dist = regs[b + _MG_DISTORTION]
     depth = int(regs[b + _MG_DEPTH])
     v = b + _MG_VECTOR
-    px = np.fmod(regs[v], _TWO_PI_F)
-    py = np.fmod(regs[v + 1], _TWO_PI_F)
-    pz = np.fmod(regs[v + 2], _TWO_PI_F)
+    px = fmod(regs[v], _TWO_PI_F)
+    py = fmod(regs[v + 1], _TWO_PI_F)
+    pz = fmod(regs[v + 2], _TWO_PI_F)
     x = math.sin((px + py + pz) * 5.0 * scale)
     y = math.cos((-px + py - pz) * 5.0 * scale)
     z = -math.cos((-px - py + pz) * 5.0 * scale)

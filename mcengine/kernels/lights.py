@@ -23,7 +23,9 @@ Per lamp type (Cycles 5.0, intern/cycles/kernel/light/ and scene/light.cpp):
   angle/2 and radiance S / (pi sin^2(angle/2)), otherwise a delta direction;
 * area: one-sided (emits into local -Z), rectangle or ellipse whose extents
   are multiplied by the object scale, radiance P / (pi A) (P / pi without
-  ``normalize``), with the ``spread`` attenuation;
+  ``normalize``), with the ``spread`` attenuation; a rectangle (or the part of
+  it a spread lets reach the point) is sampled uniformly in solid angle, an
+  ellipse uniformly in area, as Cycles samples them;
 * emissive triangles: radiance colour x strength on both sides.
 
 Lamps are transparent to rays: a ray that passes through a lamp collects its
@@ -292,6 +294,93 @@ def spread_window(lamps, li, px, py, pz):
     return x0, x1, y0, y1, (x1 - x0) * (y1 - y0)
 
 
+# Rectangular area lights are sampled by solid angle down to this solid angle (sr), and
+# while the window is not seen nearly edge-on (the squared normalised edge normals below
+# RECT_MAX_NZ2); beyond either, by area.  float64 keeps Urena's formulas accurate far
+# below Cycles' float32 limits (1e-5 and 0.99999), and the choice changes noise only.
+RECT_MIN_SOLID_ANGLE = 1e-10
+RECT_MAX_NZ2 = 1.0 - 1e-12
+
+
+@device
+def _asin(x):
+    return math.asin(min(max(x, -1.0), 1.0))
+
+
+@device
+def rect_solid_angle(lamps, li, px, py, pz, x0, x1, y0, y1):
+    """The window [x0, x1] x [y0, y1] (lamp coordinates, metres) of rectangular lamp li seen
+    from p, as a spherical rectangle (Urena et al. 2013, in the form of Cycles' area.h,
+    area_light_rect_sample, which sums arcsines where the paper sums arccosines and loses
+    small rectangles to cancellation).
+
+    Returns ``(S, sx0, sx1, sy0, sy1, z0, b0, b1, g)``: the solid angle S, the window
+    relative to p's foot on the lamp's plane, z0 = -(p's distance to the plane), and the
+    constants ``rect_sample_point`` needs.  S = 0 where the solid angle is too small, or
+    the window too nearly edge-on, for the formulas (then the window is sampled by area):
+    below RECT_MIN_SOLID_ANGLE, far below Cycles' float32 limit of 1e-5."""
+    dx, dy, dz = lamps[li, L_POS] - px, lamps[li, L_POS + 1] - py, lamps[li, L_POS + 2] - pz
+    xc = dx * lamps[li, L_AX] + dy * lamps[li, L_AX + 1] + dz * lamps[li, L_AX + 2]
+    yc = dx * lamps[li, L_AY] + dy * lamps[li, L_AY + 1] + dz * lamps[li, L_AY + 2]
+    z0 = -abs(dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2])
+    sx0, sx1, sy0, sy1 = xc + x0, xc + x1, yc + y0, yc + y1
+    z2 = z0 * z0
+    n0 = -sy0 / math.sqrt(sy0 * sy0 + z2)
+    n1 = sx1 / math.sqrt(sx1 * sx1 + z2)
+    n2 = sy1 / math.sqrt(sy1 * sy1 + z2)
+    n3 = -sx0 / math.sqrt(sx0 * sx0 + z2)
+    g2 = _asin(-n2 * n3)
+    g3 = _asin(-n3 * n0)
+    s = -(_asin(-n0 * n1) + _asin(-n1 * n2) + g2 + g3)
+    if not (s >= RECT_MIN_SOLID_ANGLE) or min(n0 * n0, n1 * n1, n2 * n2, n3 * n3) > RECT_MAX_NZ2:
+        s = 0.0
+    return s, sx0, sx1, sy0, sy1, z0, n0, n2, g2 + g3
+
+
+@device
+def rect_sample_point(s, sx0, sx1, sy0, sy1, z0, b0, b1, g, u1, u2):
+    """A point (x, y), relative to p's foot on the lamp's plane, of the spherical rectangle
+    ``rect_solid_angle`` gave, uniform in solid angle for (u1, u2) uniform."""
+    au = u1 * s + g
+    sin_au = math.sin(au)
+    fu = (math.cos(au) * b0 + b1) / sin_au if sin_au != 0.0 else 0.0
+    cu = min(max(math.copysign(1.0 / math.sqrt(fu * fu + b0 * b0), fu), -1.0), 1.0)
+    xu = min(max(-(cu * z0) / max(math.sqrt(1.0 - cu * cu), 1e-300), sx0), sx1)
+    d2 = xu * xu + z0 * z0
+    h0 = sy0 / math.sqrt(d2 + sy0 * sy0)
+    h1 = sy1 / math.sqrt(d2 + sy1 * sy1)
+    hv = h0 + u2 * (h1 - h0)
+    hv2 = hv * hv
+    yv = hv * math.sqrt(d2 / (1.0 - hv2)) if hv2 < 1.0 else sy1
+    return xu, min(max(yv, sy0), sy1)
+
+
+@device
+def _area_sample(lamps, li, px, py, pz, a, b, pdf, area):
+    """``sample_lamp``'s result for the point (a hx, b hy) of area lamp li, drawn with the
+    solid-angle pdf ``pdf``, or (``pdf`` 0) uniformly from a window of area ``area``."""
+    cx, cy, cz = lamps[li, L_POS], lamps[li, L_POS + 1], lamps[li, L_POS + 2]
+    hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
+    qx = cx + a * hx * lamps[li, L_AX] + b * hy * lamps[li, L_AY]
+    qy = cy + a * hx * lamps[li, L_AX + 1] + b * hy * lamps[li, L_AY + 1]
+    qz = cz + a * hx * lamps[li, L_AX + 2] + b * hy * lamps[li, L_AY + 2]
+    dx, dy, dz = qx - px, qy - py, qz - pz
+    d2 = dx * dx + dy * dy + dz * dz
+    dist = math.sqrt(d2)
+    if dist == 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    wx, wy, wz = dx / dist, dy / dist, dz / dist
+    # One-sided: the lamp emits along -Z, so wi (towards it) must go along +Z.
+    cos_l = wx * lamps[li, L_AZ] + wy * lamps[li, L_AZ + 1] + wz * lamps[li, L_AZ + 2]
+    if cos_l <= 0.0:
+        return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
+    s = area_spread(lamps, li, cos_l)
+    if pdf <= 0.0:
+        pdf = d2 / (area * cos_l)
+    return (wx, wy, wz, dist, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1],
+            s * lamps[li, L_RADIANCE + 2], pdf)
+
+
 @device
 def sample_lamp(lamps, li, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
@@ -325,11 +414,22 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
         sample_area = lamps[li, L_AREA]
         inside = True
         clipped = False
+        x0, x1, y0, y1 = -hx, hx, -hy, hy
         if lamps[li, L_SPREAD_TAN] >= 0.0:
             x0, x1, y0, y1, sample_area = spread_window(lamps, li, px, py, pz)
             if sample_area <= 0.0:
                 return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
             clipped = sample_area != lamps[li, L_AREA]
+        if lamps[li, L_ELLIPSE] <= 0.0:
+            # A rectangle (or the rectangle of it that can light p): by solid angle, as
+            # Cycles samples it; by area (below) where the solid angle is too small.
+            s, sx0, sx1, sy0, sy1, z0, b0, b1, g = rect_solid_angle(lamps, li, px, py, pz,
+                                                                   x0, x1, y0, y1)
+            if s > 0.0:
+                xu, yv = rect_sample_point(s, sx0, sx1, sy0, sy1, z0, b0, b1, g, u1, u2)
+                # The point, on the lamp's plane: p's foot is at -(sx0 - x0, sy0 - y0).
+                a, b = (xu - (sx0 - x0)) / hx, (yv - (sy0 - y0)) / hy
+                return _area_sample(lamps, li, px, py, pz, a, b, 1.0 / s, 0.0)
         if clipped:
             # Spread: sample the window of the light that can reach p, uniformly
             # (points of an ellipse's window outside the ellipse give nothing).
@@ -343,23 +443,7 @@ def sample_lamp(lamps, li, px, py, pz, u1, u2):
             a, b = 2.0 * u1 - 1.0, 2.0 * u2 - 1.0
         if not inside:
             return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        qx = cx + a * hx * lamps[li, L_AX] + b * hy * lamps[li, L_AY]
-        qy = cy + a * hx * lamps[li, L_AX + 1] + b * hy * lamps[li, L_AY + 1]
-        qz = cz + a * hx * lamps[li, L_AX + 2] + b * hy * lamps[li, L_AY + 2]
-        dx, dy, dz = qx - px, qy - py, qz - pz
-        d2 = dx * dx + dy * dy + dz * dz
-        dist = math.sqrt(d2)
-        if dist == 0.0:
-            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        wx, wy, wz = dx / dist, dy / dist, dz / dist
-        # One-sided: the lamp emits along -Z, so wi (towards it) must go along +Z.
-        cos_l = wx * lamps[li, L_AZ] + wy * lamps[li, L_AZ + 1] + wz * lamps[li, L_AZ + 2]
-        if cos_l <= 0.0:
-            return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0
-        s = area_spread(lamps, li, cos_l)
-        pdf = d2 / (sample_area * cos_l)
-        return (wx, wy, wz, dist, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1],
-                s * lamps[li, L_RADIANCE + 2], pdf)
+        return _area_sample(lamps, li, px, py, pz, a, b, 0.0, sample_area)
 
     # Point and spot lamps.
     r = lamps[li, L_RADIUS]
@@ -460,13 +544,18 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
             return math.inf, 0.0, 0.0, 0.0, 0.0
         s = area_spread(lamps, li, cos_l)
         sample_area = lamps[li, L_AREA]
+        hx, hy = lamps[li, L_HALF_X], lamps[li, L_HALF_Y]
+        x0, x1, y0, y1 = -hx, hx, -hy, hy
         if lamps[li, L_SPREAD_TAN] >= 0.0:
             # The light sampler only draws from the spread window seen from v.
             x0, x1, y0, y1, sample_area = spread_window(lamps, li, vx, vy, vz)
-            ax, by_ = a * lamps[li, L_HALF_X], b * lamps[li, L_HALF_Y]
+            ax, by_ = a * hx, b * hy
             if sample_area <= 0.0 or ax < x0 or ax > x1 or by_ < y0 or by_ > y1:
                 return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], 0.0
-        pdf = t * t / (sample_area * cos_l)
+        sa = 0.0
+        if lamps[li, L_ELLIPSE] <= 0.0:       # a rectangle: sampled by solid angle from v
+            sa = rect_solid_angle(lamps, li, vx, vy, vz, x0, x1, y0, y1)[0]
+        pdf = 1.0 / sa if sa > 0.0 else t * t / (sample_area * cos_l)
         return t, s * lamps[li, L_RADIANCE], s * lamps[li, L_RADIANCE + 1], s * lamps[li, L_RADIANCE + 2], pdf
 
     r = lamps[li, L_RADIUS]

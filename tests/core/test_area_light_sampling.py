@@ -25,6 +25,7 @@ from mcengine.kernels.lights import (
     pack_lights,
     rect_solid_angle,
     sample_lamp,
+    spherical_rectangle,
     spread_window,
 )
 from mcengine.scene import Light
@@ -43,10 +44,11 @@ def lamp_table(spread=math.pi) -> np.ndarray:
     return pack_lights([light], 10.0)[0]
 
 
-# Receivers, in the lamp's frame (x, y along its sides, t in front of it): below it, just
-# beside it, far to the side, nearly in its plane.
-POINTS = {"below": (0.05, -0.03, 1.5), "near": (0.4, 0.1, 0.2), "side": (-2.0, 1.5, 1.0),
-          "grazing": (3.0, 0.0, 0.01)}
+# Receivers, in the lamp's frame (x, y along its sides, t in front of it), nearer than
+# RECT_NEAR = 2 half-diagonals (0.58 m) to its centre: below it, just beside it, to the
+# side, nearly in its plane.
+POINTS = {"below": (0.05, -0.03, 0.4), "near": (0.4, 0.1, 0.2), "side": (-0.45, 0.3, 0.1),
+          "grazing": (0.5, 0.0, 0.01)}
 
 
 def receiver(lamps, x, y, t) -> tuple:
@@ -99,10 +101,10 @@ def test_solid_angle_equals_the_quadrature(where):
 
 
 @pytest.mark.parametrize("where,spread_deg", [("below", 180.0), ("near", 180.0), ("side", 180.0),
-                                              ("grazing", 180.0), ("below", 10.0)])
+                                              ("grazing", 180.0), ("below", 60.0)])
 def test_points_are_uniform_in_solid_angle(where, spread_deg):
     """Pearson chi-square of the sampled points over an 8 x 8 grid of the window (the part
-    of the lamp that can light p: with a 10 deg spread, a small square of it), each cell
+    of the lamp that can light p: with a 60 deg spread, a square of it), each cell
     expected in proportion to its solid angle; every pdf is 1 / S, and a ray from p along
     each sampled direction meets the lamp with that pdf and the same radiance."""
     lamps = lamp_table(math.radians(spread_deg))
@@ -121,8 +123,8 @@ def test_points_are_uniform_in_solid_angle(where, spread_deg):
     edges_x = np.linspace(x0, x1, CELLS + 1)
     edges_y = np.linspace(y0, y1, CELLS + 1)
     observed = np.histogram2d(x, y, bins=(edges_x, edges_y))[0]
-    expected = np.array([[rect_solid_angle(lamps, 0, *p, edges_x[i], edges_x[i + 1], edges_y[j],
-                                           edges_y[j + 1])[0] for j in range(CELLS)]
+    expected = np.array([[spherical_rectangle(lamps, 0, *p, edges_x[i], edges_x[i + 1], edges_y[j],
+                                              edges_y[j + 1])[0] for j in range(CELLS)]
                          for i in range(CELLS)]) / s * n
     assert expected.sum() == pytest.approx(n, rel=1e-9)
     stat = float(((observed - expected) ** 2 / expected).sum())
@@ -131,20 +133,24 @@ def test_points_are_uniform_in_solid_angle(where, spread_deg):
     assert p_value > 0.001
 
 
-def test_a_tiny_solid_angle_is_sampled_by_area():
-    """100 km in front of it the lamp subtends 1.5e-11 sr: sampled uniformly over its area, with the
-    area pdf d^2 / (A cos), which intersect_lamp gives the same direction."""
+@pytest.mark.parametrize("where", ["far", "edge-on"])
+def test_far_or_edge_on_lamps_are_sampled_by_area(where):
+    """From 3 half-diagonals away (beyond RECT_NEAR), and from 1e-7 m in front of the
+    lamp's plane, 0.25 m beside it (seen edge-on: RECT_MAX_NZ2), the lamp is sampled
+    uniformly over its area, with the area pdf d^2 / (A cos), which intersect_lamp gives
+    the same direction (to 1e-6: cos is 2e-7 there)."""
     lamps = lamp_table()
-    p = receiver(lamps, 0.0, 0.0, 1e5)
+    p = receiver(lamps, *{"far": (0.3, 0.4, 0.7), "edge-on": (0.5, 0.0, 1e-7)}[where])
     assert rect_solid_angle(lamps, 0, *p, -SX / 2, SX / 2, -SY / 2, SY / 2)[0] == 0.0
     draws = _draw(lamps, *p, np.random.default_rng(8).random((20_000, 2)))
+    assert (draws[:, 4] > 0.0).all()
     x, y, _ = local_points(lamps, p, draws)
     counts = np.histogram2d(x, y, bins=(np.linspace(-SX / 2, SX / 2, 5),
                                         np.linspace(-SY / 2, SY / 2, 5)))[0]
     assert chi2.sf(float(((counts - 1250.0) ** 2 / 1250.0).sum()), 15) > 0.001
     d2 = draws[:, 3] ** 2
     cos = draws[:, :3] @ lamps[0, L_AZ:L_AZ + 3]
-    np.testing.assert_allclose(draws[:, 5], d2 / (SX * SY * cos), rtol=1e-9)
+    np.testing.assert_allclose(draws[:, 5], d2 / (SX * SY * cos), rtol=1e-6)
     np.testing.assert_allclose(draws[:, 6], draws[:, 5], rtol=1e-6)
 
 

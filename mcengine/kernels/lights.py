@@ -301,7 +301,7 @@ def spread_window(lamps, li, px, py, pz):
 # variance of one sample is 0.5 higher, median over receivers); at RECT_NEAR = 2 it is
 # 0.19 higher, at 4 0.05 and at 10 0.009, falling as the square of the lamp's apparent
 # size, while the spherical rectangle costs four arcsines, a sine and a cosine more per
-# sample, 20 % of the Cornell box's render time when every vertex paid it.  Cycles
+# sample, 22 % of the Cornell box's render time when every vertex paid it.  Cycles
 # samples every rectangle by solid angle; the choice changes noise only.  Below
 # RECT_MIN_SOLID_ANGLE (sr), or with the window seen nearly edge-on (a squared normalised
 # edge normal above RECT_MAX_NZ2), the window is sampled by area too: float64 keeps

@@ -18,7 +18,6 @@ its image is read from the per-pixel sums (Cycles' kernel/film/read.h):
             (Vector: the kernels sum a weight of 1 per such sample); 0 where none
             did, and everywhere when motion blur is on (Cycles writes the pass
             only without motion blur)
-``zero``    not computed by MC Engine (written as 0, with a warning)
 
 :class:`RenderPasses` holds a render's pass settings; :func:`layout` assigns
 film columns (only for the passes enabled, and the colour passes the light
@@ -37,7 +36,7 @@ from .kernels import passes as kp
 from .kernels.camera import camera_axes, view_plane
 
 __all__ = ["PassInfo", "PASSES", "CRYPTO_TYPES", "DENOISING_PASSES", "NOISY_IMAGE", "RenderPasses",
-           "Layout", "layout", "read", "MIST_FALLOFFS", "UNSUPPORTED",
+           "Layout", "layout", "read", "MIST_FALLOFFS",
            "cryptomatte_metadata", "kernel_data", "world_to_camera", "world_to_raster",
            "motion_corners", "bytes_per_pixel"]
 
@@ -79,7 +78,7 @@ PASSES = (
              kp.P_TRANSMISSION_COLOR, "mean"),
     PassInfo("Emission", "RGB", "COLOR", "use_pass_emit", kp.P_EMISSION, "exposed"),
     PassInfo("Environment", "RGB", "COLOR", "use_pass_environment", kp.P_ENVIRONMENT, "exposed"),
-    PassInfo("Ambient Occlusion", "RGB", "COLOR", "use_pass_ambient_occlusion", kp.P_AO, "zero"),
+    PassInfo("Ambient Occlusion", "RGB", "COLOR", "use_pass_ambient_occlusion", kp.P_AO, "mean"),
 )
 BY_NAME = {p.name: p for p in PASSES}
 
@@ -101,11 +100,6 @@ NOISY_IMAGE = PassInfo("Noisy Image", "RGBA", "COLOR", "", -1, "")
 # Mist falloff (world.mist_settings.falloff) -> the exponent Cycles applies.
 MIST_FALLOFFS = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
 
-# Passes MC Engine lists but does not compute, and what it writes instead.
-UNSUPPORTED = {
-    "Ambient Occlusion": "ambient occlusion is not computed (written as 0)",
-}
-
 
 @dataclass
 class RenderPasses:
@@ -115,7 +109,9 @@ class RenderPasses:
     types ("CryptoObject", ...) with ``cryptomatte_depth`` ranks each;
     ``denoising_data`` adds Cycles' Denoising Normal, Albedo and Depth.
     Mist settings are the world's; ``alpha_threshold`` is the view layer's
-    (normal and UV come from the first surface at least that opaque).
+    (normal and UV come from the first surface at least that opaque).  ``ao_distance``
+    is how far the Ambient Occlusion pass looks: the world's AO distance (Blender's
+    default, 10, without a world).
     ``view_layer`` names the Cryptomatte metadata layers.  With ``motion_blur`` on, the
     Vector pass is left at 0, as Cycles leaves it.
     """
@@ -128,6 +124,7 @@ class RenderPasses:
     mist_depth: float = 25.0
     mist_falloff: str = "QUADRATIC"
     alpha_threshold: float = 0.5
+    ao_distance: float = 10.0
     view_layer: str = "ViewLayer"
     motion_blur: bool = False
 
@@ -179,7 +176,7 @@ def layout(passes: RenderPasses, denoising_guides: tuple = ()) -> Layout:
     by, and the guide passes ``denoising_guides``: slots the denoiser reads)."""
     slots = []
     for p in PASSES:
-        if p.name in passes.enabled and p.readout != "zero" and not (
+        if p.name in passes.enabled and not (
                 p.slot == kp.P_VECTOR and passes.motion_blur):
             slots.append(p.slot)
             if p.divide >= 0:
@@ -216,7 +213,7 @@ def read(name: str, sums: np.ndarray, count: np.ndarray, lay: Layout, exposure: 
     info = BY_NAME.get(name) or next(p for p in DENOISING_PASSES if p.name == name)
     width = len(info.channels)
     n = count.shape[0]
-    if info.readout == "zero" or info.slot not in lay:
+    if info.slot not in lay:
         return np.zeros((n, width), np.float32)
     col = lay.columns[info.slot]
     if info.readout == "motion":
@@ -324,6 +321,7 @@ def kernel_data(lay: Layout, passes: RenderPasses, camera_to_world: np.ndarray, 
     fcfg[kp.PV_MIST_FALLOFF] = MIST_FALLOFFS[passes.mist_falloff]
     fcfg[kp.PV_ALPHA_THRESHOLD] = passes.alpha_threshold
     fcfg[kp.PV_ORTHO] = 1.0 if ortho else 0.0
+    fcfg[kp.PV_AO_DISTANCE] = passes.ao_distance
     fcfg[kp.PV_CAMERA:kp.PV_CAMERA + 12] = world_to_camera(camera_to_world).reshape(-1)
     if rasters is not None:
         fcfg[kp.PV_RASTER:kp.PV_RASTER + 36] = np.asarray(rasters, np.float64).reshape(-1)

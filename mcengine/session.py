@@ -39,7 +39,14 @@ from .integrators import get as integrator_info
 from .kernels import classic, light_tracing, path
 from .kernels.classic import WHITTED_RAYS
 from .kernels.closures.layout import ROUGHNESS_SQ_THRESHOLD
-from .kernels.passes import P_DENOISING_ALBEDO, P_DENOISING_NORMAL, PC_DENOISE, PC_LIGHT, alloc_pass_buffers
+from .kernels.passes import (
+    P_AO,
+    P_DENOISING_ALBEDO,
+    P_DENOISING_NORMAL,
+    PC_DENOISE,
+    PC_LIGHT,
+    alloc_pass_buffers,
+)
 from .kernels.state import (
     MF_CLOSURES_ONLY,
     ST_BOUNCE_RAYS,
@@ -199,21 +206,24 @@ class _Buffers:
     _pool: dict = {}
     _pool_lock = threading.Lock()
 
-    def __init__(self, batch, classic, passes=False):
-        self.key = (batch, classic, passes)
+    def __init__(self, batch, classic, passes=False, ao=False):
+        self.key = (batch, classic, passes, ao)
         self.state = alloc_path_state(batch)
-        self.shadow = alloc_shadow_queue(batch)
+        # A shadow ray per path and bounce, and at camera vertices an Ambient Occlusion one.
+        shadows = 2 * batch if ao else batch
+        self.shadow = alloc_shadow_queue(shadows)
         # Render passes' per-path buffers: full size only for light passes or denoising.
-        self.passes = alloc_pass_buffers(batch if passes else 1)
+        self.passes = alloc_pass_buffers(batch if passes else 1, shadows if passes else 1)
         if classic:   # a second generation of rays and per-camera-sample sums
             self.next_state = alloc_path_state(batch)
             self.acc = np.zeros((batch, 4))
             self.root_pixel = np.zeros(batch, np.int32)
 
     @staticmethod
-    def bytes_for(batch, classic, passes=False) -> int:
+    def bytes_for(batch, classic, passes=False, ao=False) -> int:
         """Memory of one worker's buffers for ``batch`` paths (without allocating them)."""
-        one, two = _Buffers(1, classic, passes).nbytes, _Buffers(2, classic, passes).nbytes
+        one = _Buffers(1, classic, passes, ao).nbytes
+        two = _Buffers(2, classic, passes, ao).nbytes
         return (two - one) * batch + (2 * one - two)     # per path, plus the fixed part
 
     @property
@@ -224,12 +234,12 @@ class _Buffers:
         return sum(a.nbytes for a in arrays)
 
     @classmethod
-    def take(cls, batch, classic, passes=False) -> "_Buffers":
+    def take(cls, batch, classic, passes=False, ao=False) -> "_Buffers":
         with cls._pool_lock:
-            free = cls._pool.get((batch, classic, passes))
+            free = cls._pool.get((batch, classic, passes, ao))
             if free:
                 return free.pop()
-        return cls(batch, classic, passes)
+        return cls(batch, classic, passes, ao)
 
     def give_back(self) -> None:
         with self._pool_lock:
@@ -308,9 +318,11 @@ class RenderSession:
             ((P_DENOISING_NORMAL,) if scene.denoising.uses_normal else ())
         self.pass_layout = render_passes.layout(scene.passes, guides)
         self.pd = pack_passes(scene, self.pass_layout)
-        # Per-path pass buffers are needed by light passes and denoising features only.
-        self._path_passes = bool(self.pd.cfg[PC_LIGHT]
-                                 or self.pd.cfg[PC_DENOISE])
+        # The workers' buffers (``_Buffers``' arguments after the batch size): per-path pass
+        # buffers are needed by light passes and denoising features only, a second shadow ray
+        # per path by the Ambient Occlusion pass.
+        self._buffers = (self._classic, bool(self.pd.cfg[PC_LIGHT] or self.pd.cfg[PC_DENOISE]),
+                         bool(self.pd.cfg[P_AO] >= 0))
         x0, y0, x1, y1 = scene.film.window
         if self.light_tables is not None:
             host_bytes_per_pixel += self.threads * 3 * 8     # the workers' light-tracing films
@@ -465,8 +477,7 @@ class RenderSession:
     def _check_memory(self, pixels: int, host_bytes_per_pixel: int) -> None:
         """SceneError, with the figures, if the render cannot fit in the memory left."""
         need = memory.estimate(pixels, self.scene.geometry.num_triangles,
-                               self.threads * _Buffers.bytes_for(self.batch_size, self._classic,
-                                                                 self._path_passes),
+                               self.threads * _Buffers.bytes_for(self.batch_size, *self._buffers),
                                host_bytes_per_pixel, 8 * self.pass_layout.stride,
                                self.stats.texture_bytes)
         free = memory.available()
@@ -521,7 +532,7 @@ class RenderSession:
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)
         if w is None:
-            w = _Worker(_Buffers.take(self.batch_size, self._classic, self._path_passes), self.accel,
+            w = _Worker(_Buffers.take(self.batch_size, *self._buffers), self.accel,
                         self.sc, self._splat_pixels)
             self._workers.w = w
             scratch = sum(a.nbytes for a in w.scratch)
@@ -561,7 +572,7 @@ class RenderSession:
         """Compile (or load from the cache) every kernel on a one-pixel scratch film."""
         size = max(64, self.batch_size // max(self.roots_per_chunk, 1)) if self._classic else 64
         scratch_film = Film(1, 1, self.pass_layout.stride)
-        self._trace_with(_Worker(_Buffers(size, self._classic, self._path_passes), self.accel, self.sc,
+        self._trace_with(_Worker(_Buffers(size, *self._buffers), self.accel, self.sc,
                                  self._splat_pixels),
                          np.zeros(1, np.int32), 1, scratch_film.arrays, scratch_film.passes)
 

@@ -22,7 +22,6 @@ from mcengine.passes import (
     MIST_FALLOFFS,
     NOISY_IMAGE,
     PASSES,
-    UNSUPPORTED,
     RenderPasses,
 )
 
@@ -44,7 +43,9 @@ _OTHER_PASSES = (
 
 def enabled_passes(scene, view_layer) -> RenderPasses:
     """The passes ``view_layer`` enables that MC Engine writes, with their settings."""
-    mist = getattr(getattr(scene, "world", None), "mist_settings", None)
+    world = getattr(scene, "world", None)
+    mist = getattr(world, "mist_settings", None)
+    light = getattr(world, "light_settings", None)
     crl = getattr(view_layer, "cycles", None)
     return RenderPasses(
         enabled=tuple(p.name for p in PASSES if getattr(view_layer, p.setting, False)),
@@ -57,6 +58,7 @@ def enabled_passes(scene, view_layer) -> RenderPasses:
         mist_falloff=mist.falloff if mist is not None and mist.falloff in MIST_FALLOFFS
         else "QUADRATIC",
         alpha_threshold=float(getattr(view_layer, "pass_alpha_threshold", 0.5)),
+        ao_distance=float(light.distance) if light is not None else 10.0,
         view_layer=view_layer.name)
 
 
@@ -86,11 +88,8 @@ def result_passes(scene, view_layer) -> list[tuple[str, str, str]]:
 
 
 def export_passes(ctx, scene, view_layer, integrator_name: str) -> RenderPasses:
-    """The render's passes; warns about enabled passes MC Engine leaves at 0 or omits."""
+    """The render's passes; warns about enabled passes MC Engine omits."""
     passes = enabled_passes(scene, view_layer)
-    for name in passes.enabled:
-        if name in UNSUPPORTED:
-            ctx.warn(f"{name} pass: {UNSUPPORTED[name]}", f"{name} pass")
     crl = getattr(view_layer, "cycles", None)
     others = [label for owner, prop, label in _OTHER_PASSES
               if getattr(crl if owner == "cycles" else view_layer, prop, False)]

@@ -74,6 +74,9 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
     cycles = cycles_settings(ctx, scene)
     if cycles is None:
         return Integrator()
+    if getattr(cycles, "use_fast_gi", False):
+        ctx.warn("Fast GI Approximation is not supported; rendering full global illumination",
+                 "Fast GI")
     samples = int(cycles.samples)
     if cycles.use_layer_samples == "USE" and view_layer.samples > 0:
         samples = int(view_layer.samples)  # Cycles' per-view-layer sample override

@@ -24,7 +24,10 @@ cryptomatte_passes.h) decide what is written where:
 * **denoising features**: at the first surface whose closures are not mostly
   specular (more than a quarter of the sample weight diffuse-like), the
   diffuse albedo times the product of the specular albedos before it, and
-  the average closure normal in camera space.
+  the average closure normal in camera space;
+* **ambient occlusion**: at the surfaces a camera ray meets, a ray in a
+  cosine-distributed direction that looks as far as the world's AO distance
+  and, unoccluded, adds the path's throughput times the surface's alpha.
 
 The functions here are inlined into ``path``; a render with no pass enabled
 skips them with one flag test per event, and its pass buffers are one
@@ -59,7 +62,18 @@ from .closures.layout import (
     ROUGHNESS_SQ_THRESHOLD,
 )
 from .closures.microfacet import microfacet_albedo
-from .state import PF_DENOISE, PF_FIRST_SAMPLE, PF_PASS_DONE, PF_SURFACE_PASS, PF_TRANSPARENT_BG
+from .sampling import cosine_hemisphere, orthonormal_basis
+from .shading import push_shadow, shader_normal
+from .state import (
+    PF_DENOISE,
+    PF_FIRST_SAMPLE,
+    PF_PASS_DONE,
+    PF_SURFACE_PASS,
+    PF_TRANSPARENT_BG,
+    SK_AO,
+    SK_DIRECT,
+    SK_INDIRECT,
+)
 
 # -- pass slots: index into PassData.cfg, whose value is the pass's first film column -----------
 P_DEPTH = 0
@@ -106,16 +120,14 @@ PV_ALPHA_THRESHOLD = 3
 PV_ORTHO = 4               # 1: orthographic camera (mist is the distance along the view axis)
 PV_CAMERA = 5              # 12: world to camera (Cycles' camera space: +z forward), rows x, y, z
 PV_RASTER = 17             # 3 x 12: world to raster (rows x, y, w) now, at the previous and the
-PV_SIZE = 53               # next frame (Vector pass; raster y points up, as Cycles')
+                           # next frame (Vector pass; raster y points up, as Cycles')
+PV_AO_DISTANCE = 53        # how far the Ambient Occlusion pass's rays look (the world's AO distance)
+PV_SIZE = 54
 
 # Kinds of light (light_pass).
 LK_SURFACE = 0             # emission of a surface or a lamp
 LK_BACKGROUND = 1          # the world
 
-# Shadow rays' pass kinds (PassBuffers.skind).
-SK_NONE = 0
-SK_DIRECT = 1
-SK_INDIRECT = 2
 
 PassData = namedtuple("PassData", [
     "cfg",           # (PC_SIZE,) int64   film column of each pass (-1: off), then PC_* entries
@@ -129,15 +141,14 @@ PassData = namedtuple("PassData", [
 PassBuffers = namedtuple("PassBuffers", [
     "pw",            # (B, 6) f64  path: diffuse and glossy pass weights of the first bounce
     "dn",            # (B, 3) f64  path: denoising feature throughput
-    "sw",            # (B, 6) f64  shadow ray: its pass weights
-    "skind",         # (B,) int8   shadow ray: SK_*
+    "sw",            # (S, 6) f64  shadow ray: its pass weights (S: the shadow queue's length)
 ])
 
 
-def alloc_pass_buffers(n: int) -> PassBuffers:
-    """Pass buffers for n paths (n = 1 when no light pass or denoising feature is on)."""
-    return PassBuffers(pw=np.zeros((n, 6)), dn=np.zeros((n, 3)), sw=np.zeros((n, 6)),
-                       skind=np.zeros(n, np.int8))
+def alloc_pass_buffers(n: int, n_shadow: int) -> PassBuffers:
+    """Pass buffers for n paths and n_shadow shadow rays (1 and 1 when no light pass or
+    denoising feature is on)."""
+    return PassBuffers(pw=np.zeros((n, 6)), dn=np.zeros((n, 3)), sw=np.zeros((n_shadow, 6)))
 
 
 # -- closures ------------------------------------------------------------------------------------
@@ -275,12 +286,58 @@ def light_pass(pd, fp, pix, flags, bounce, pb, i, r, g, b, kind):
 
 
 @device
-def shadow_pass(pd, fp, pix, pb, s, r, g, b):
-    """The light of unoccluded shadow ray s (Cycles' film_write_direct_light)."""
-    kind = pb.skind[s]
-    if kind != SK_NONE:
+def shadow_pass(pd, fp, pix, pb, s, kind, r, g, b):
+    """The light of unoccluded shadow ray s, of kind SK_* (Cycles' film_write_direct_light)."""
+    if kind == SK_DIRECT or kind == SK_INDIRECT:
         split_light(pd, fp, pix, kind == SK_DIRECT, pb.sw[s, 0], pb.sw[s, 1], pb.sw[s, 2],
                     pb.sw[s, 3], pb.sw[s, 4], pb.sw[s, 5], r, g, b)
+
+
+# -- ambient occlusion -----------------------------------------------------------------------
+@device
+def queue_ao_ray(pd, sc, scratch, sq, n_shadow, i, ncl, sp, br, bg, bb, tr, tg, tb, u1, u2,
+                 depths, transparent_left):
+    """Queue the Ambient Occlusion pass's ray at a surface the camera sees (Cycles'
+    integrate_surface_ao); returns the queue length.
+
+    The ray leaves in a cosine-distributed direction around the diffuse closures' normal
+    (their weights' averages weigh the normals; the shader's normal without diffuse
+    closures), and looks as far as the world's AO distance.  Unoccluded, it adds the path's
+    throughput (br, bg, bb) times the surface's alpha (1 - transparency (tr, tg, tb)) to the
+    pass: Cycles' pass is the mean of that over the pixel's samples.
+    """
+    ar, ag, ab = br * min(max(1.0 - tr, 0.0), 1.0), bg * min(max(1.0 - tg, 0.0), 1.0), \
+        bb * min(max(1.0 - tb, 0.0), 1.0)
+    if ar == 0.0 and ag == 0.0 and ab == 0.0:
+        return n_shadow
+    cl = scratch.cl
+    nx = ny = nz = 0.0
+    for k in range(ncl):
+        if is_diffuse(cl[k, CL_TYPE]):
+            w = abs(cl[k, CL_W] + cl[k, CL_W + 1] + cl[k, CL_W + 2]) * (1.0 / 3.0)
+            nx, ny, nz = nx + w * cl[k, CL_N], ny + w * cl[k, CL_N + 1], nz + w * cl[k, CL_N + 2]
+    sx, sy, sz = shader_normal(sc, scratch.regs, sp)
+    length = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if length > 0.0:
+        nx, ny, nz = nx / length, ny / length, nz / length
+    else:
+        nx, ny, nz = sx, sy, sz
+    x, y, z = cosine_hemisphere(u1, u2)
+    tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
+    wix, wiy, wiz = x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz
+    queued = push_shadow(sq, sc, n_shadow, i, sp, sx, sy, sz, wix, wiy, wiz,
+                         pd.fcfg[PV_AO_DISTANCE], 0.0, 0.0, 0.0, ar, ag, ab, transparent_left,
+                         depths)
+    if queued > n_shadow:
+        sq.kind[n_shadow] = SK_AO
+    return queued
+
+
+@device
+def ao_pass(pd, fp, pix, r, g, b):
+    """The throughput an unoccluded Ambient Occlusion ray carries (Cycles'
+    film_write_direct_light for PATH_RAY_SHADOW_FOR_AO)."""
+    _add3(fp, pix, pd.cfg[P_AO], r, g, b)
 
 
 @device

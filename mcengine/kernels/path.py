@@ -49,21 +49,31 @@ from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light
 from .passes import (
     LK_BACKGROUND,
     LK_SURFACE,
+    P_AO,
     PC_DATA,
     PC_DENOISE,
     PC_LIGHT,
     PC_SPLIT,
-    SK_DIRECT,
-    SK_INDIRECT,
+    ao_pass,
     background_passes,
     light_pass,
+    queue_ao_ray,
     shadow_pass,
     singular_weights,
     split_eval,
     split_light,
     surface_passes,
 )
-from .sampling import SET_BSDF, SET_LIGHT, SET_TERMINATE, bounce_set, sample_1d, sample_4d
+from .sampling import (
+    SET_AO,
+    SET_BSDF,
+    SET_LIGHT,
+    SET_TERMINATE,
+    bounce_set,
+    sample_1d,
+    sample_2d,
+    sample_4d,
+)
 from .shading import (
     direct_light,
     light_from_emitter,
@@ -103,6 +113,9 @@ from .state import (
     PF_TERMINATE,
     PF_TRANSPARENT,
     PF_TRANSPARENT_BG,
+    SK_AO,
+    SK_DIRECT,
+    SK_INDIRECT,
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
     ST_SELF_HITS,
@@ -124,6 +137,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     light_passes = pd.cfg[PC_LIGHT] != 0
     split = pd.cfg[PC_SPLIT] != 0     # light split into diffuse/glossy/transmission
     surface_pass_work = pd.cfg[PC_DATA] != 0 or pd.cfg[PC_DENOISE] != 0
+    ao = pd.cfg[P_AO] >= 0
     r0 = g0 = b0 = 0.0
     queued = 0
     n_lamps = sc.lamps.shape[0]
@@ -247,6 +261,11 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                    st.beta[i, 1], st.beta[i, 2], res.tr, res.tg, res.tb,
                                    -dx, -dy, -dz, pb, i)
             st.flags[i] = flags
+        if ao and (flags & PF_CAMERA):
+            au, av = sample_2d(sampler, key, bounce_set(vertex, SET_AO), mask)
+            n_shadow = queue_ao_ray(pd, sc, scratch, sq, n_shadow, i, ncl, sp, st.beta[i, 0],
+                                    st.beta[i, 1], st.beta[i, 2], res.tr, res.tg, res.tb, au, av,
+                                    depths, max_transparent - st.transparent[i])
 
         # -- next-event estimation: one light --------------------------------------------------
         if nee:
@@ -270,7 +289,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                     scratch, ncl, sp, dx, dy, dz, idx, pmf, depths, lu, lv,
                                     True, 1.0, max_transparent - st.transparent[i])
             if split:
-                _nee_passes(pd, fp, st, pb, i, scratch, ncl, -dx, -dy, -dz, bounce, flags,
+                _nee_passes(pd, fp, st, sq, pb, i, scratch, ncl, -dx, -dy, -dz, bounce, flags,
                             queued, n_shadow, r0, g0, b0)
 
         # -- BSDF sampling: the next ray ---------------------------------------------------------
@@ -320,8 +339,8 @@ def _pass_light(pd, fp, st, pb, i, r0, g0, b0, kind):
 
 
 @device
-def _nee_passes(pd, fp, st, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, queued, n_shadow,
-                r0, g0, b0):
+def _nee_passes(pd, fp, st, sq, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, queued,
+                n_shadow, r0, g0, b0):
     """Pass weights of the light sample just taken at path i: the BSDF's own at the first
     bounce (Cycles: direct light), else those of the first bounce.  Given to its shadow ray,
     or used at once for a light that casts no shadow."""
@@ -336,7 +355,7 @@ def _nee_passes(pd, fp, st, pb, i, scratch, ncl, wox, woy, woz, bounce, flags, q
         s = n_shadow - 1
         pb.sw[s, 0], pb.sw[s, 1], pb.sw[s, 2] = w0, w1, w2
         pb.sw[s, 3], pb.sw[s, 4], pb.sw[s, 5] = w3, w4, w5
-        pb.skind[s] = SK_DIRECT if bounce == 0 else SK_INDIRECT
+        sq.kind[s] = SK_DIRECT if bounce == 0 else SK_INDIRECT
         return
     r, g, b = st.radiance[i, 0] - r0, st.radiance[i, 1] - g0, st.radiance[i, 2] - b0
     if r != 0.0 or g != 0.0 or b != 0.0:
@@ -415,11 +434,15 @@ def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, 
     for s in range(n_shadow):
         if not occluded[s] and sq.alive[s]:
             i = sq.path[s]
+            kind = sq.kind[s]
+            if kind == SK_AO:
+                ao_pass(pd, fp, st.pixel[i], sq.contrib[s, 0], sq.contrib[s, 1], sq.contrib[s, 2])
+                continue
             st.radiance[i, 0] += sq.contrib[s, 0]
             st.radiance[i, 1] += sq.contrib[s, 1]
             st.radiance[i, 2] += sq.contrib[s, 2]
             if split:
-                shadow_pass(pd, fp, st.pixel[i], pb, s, sq.contrib[s, 0], sq.contrib[s, 1],
+                shadow_pass(pd, fp, st.pixel[i], pb, s, kind, sq.contrib[s, 0], sq.contrib[s, 1],
                             sq.contrib[s, 2])
     move_passes = pb.pw.shape[0] > 1
     m = 0

@@ -47,6 +47,7 @@ SETS_PER_BOUNCE = 16
 SET_TERMINATE = 0        # 1: Russian roulette
 SET_LIGHT = 1            # 4: point on the light u, v; which light; which emissive triangle
 SET_BSDF = 3             # 4: direction u, v; which closure; the lobe's third number
+SET_AO = 4               # 2: the Ambient Occlusion pass's direction u, v
 
 SAMPLE_BITS = INDEX_BITS   # sample index bits of a Sobol path key (Cycles' limit, 2^24 samples)
 _SAMPLE_MASK = np.uint64((1 << SAMPLE_BITS) - 1)

@@ -83,6 +83,7 @@ from .state import (
     PF_TRANSMIT,
     PF_TRANSPARENT,
     PF_TRANSPARENT_BG,
+    SK_NONE,
     ST_NONFINITE,
 )
 from .surface import smooth_surface_offset, surface_point
@@ -219,6 +220,7 @@ def push_shadow(sq, sc, n_shadow, owner, sp, nx, ny, nz, wix, wiy, wiz, dist, ln
     for k in range(5):
         sq.depths[n_shadow, k] = depths[k]
     sq.travelled[n_shadow] = 0.0
+    sq.kind[n_shadow] = SK_NONE
     return n_shadow + 1
 
 

@@ -45,6 +45,14 @@ PathState = namedtuple("PathState", [
     "t32",           # (B,) f32      Embree input: tfar
 ])
 
+# What a shadow ray's light is for (ShadowQueue.kind): Combined only, Combined and the
+# direct or the indirect light passes (with the pass weights in PassBuffers.sw), or the
+# Ambient Occlusion pass only.
+SK_NONE = 0
+SK_DIRECT = 1
+SK_INDIRECT = 2
+SK_AO = 3
+
 ShadowQueue = namedtuple("ShadowQueue", [
     "o32", "d32", "t32",   # Embree input
     "contrib",             # (B, 3) f64  radiance to add if unoccluded
@@ -57,6 +65,7 @@ ShadowQueue = namedtuple("ShadowQueue", [
                            #               glossy, transmission, transparent; transparent
                            #               surfaces passed add to the last: Light Path node)
     "travelled",           # (B,) f64    distance from the shading point to the current origin
+    "kind",                # (B,) int8   what the ray's light is for (SK_*)
 ])
 
 Scratch = namedtuple("Scratch", [
@@ -223,7 +232,8 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
                        t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
                        path=np.zeros(n, np.int32), time=np.zeros(n), target=np.zeros((n, 3)),
                        transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
-                       depths=np.zeros((n, 5), np.int32), travelled=np.zeros(n))
+                       depths=np.zeros((n, 5), np.int32), travelled=np.zeros(n),
+                       kind=np.zeros(n, np.int8))
 
 
 def alloc_scratch(sc: SceneData) -> Scratch:

@@ -53,6 +53,13 @@ def test_unknown_cycles_pattern_is_warned(scene, fake_session, monkeypatch):
                              "rendering with the Scrambled Sobol sampler"]
 
 
+def test_fast_gi_is_warned(scene, fake_session):
+    scene.cycles.use_denoising = False
+    scene.cycles.use_fast_gi = True
+    assert export_scene(fake_session).warnings == [
+        "Fast GI Approximation is not supported; rendering full global illumination"]
+
+
 def test_view_layer_samples_override(scene, fake_session):
     scene.cycles.samples = 64
     bpy.context.view_layer.samples = 5

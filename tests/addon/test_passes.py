@@ -49,6 +49,7 @@ def test_view_layer_settings_are_exported(scene, fake_session):
     scene.world = bpy.data.worlds.new("World")
     mist = scene.world.mist_settings
     mist.start, mist.depth, mist.falloff = 1.5, 12.0, "LINEAR"
+    scene.world.light_settings.distance = 3.5
     mat = bpy.data.materials.new("Paint")
     mat.pass_index = 5
     parent = bpy.data.objects.new("Rig", None)
@@ -61,6 +62,7 @@ def test_view_layer_settings_are_exported(scene, fake_session):
     assert p.enabled == ("Mist", "Normal") and p.cryptomatte == ("CryptoAsset",)
     assert (p.cryptomatte_depth, p.alpha_threshold) == (3, 0.25)
     assert (p.mist_start, p.mist_depth, p.mist_falloff) == (1.5, 12.0, "LINEAR")
+    assert p.ao_distance == 3.5
     assert p.view_layer == layer.name
     (info,) = desc.geometry.object_pass_info()
     assert (info.name, info.asset) == ("Tri", "Rig")
@@ -95,15 +97,17 @@ def test_passes_denoising_and_metadata_reach_the_file(scene, fake_session, tmp_p
     assert header["mcengine.ViewLayer.samples"] == str(scene.cycles.samples)
 
 
-def test_unsupported_passes_are_warned_and_written_as_zero(scene, fake_session, tmp_path):
+def test_unsupported_passes_are_warned(scene, fake_session, tmp_path):
     layer = scene.view_layers[0]
     layer.use_pass_ambient_occlusion = layer.use_pass_vector = True
     layer.cycles.use_pass_shadow_catcher = True
     layer.cycles.use_pass_volume_direct = True
+    scene.world = None
     bpy.ops.render.render()
-    warnings = fake_session[-1].desc.warnings
-    assert not any("Vector" in w for w in warnings)      # computed since the Vector pass
-    assert "Ambient Occlusion pass: ambient occlusion is not computed (written as 0)" in warnings
+    desc = fake_session[-1].desc
+    warnings = desc.warnings
+    assert not any("Vector" in w or "Ambient" in w for w in warnings)    # both computed
+    assert desc.passes.ao_distance == 10.0       # Cycles' AO distance without a world
     assert ("render passes not supported yet (Volume Direct, Shadow Catcher); they are not "
             "written") in warnings
 

@@ -22,11 +22,10 @@ import numpy as np
 import pytest
 
 from mcengine.imageio import read_exr_header, read_exr_layers
-from mcengine.passes import DENOISING_PASSES, PASSES, UNSUPPORTED
+from mcengine.passes import DENOISING_PASSES, PASSES
 
 ROOT = Path(__file__).resolve().parents[2]
 SIZE, SAMPLES = 48, 512
-COMPARED = [p for p in PASSES if p.name not in UNSUPPORTED]
 COLOR = {p.slot: p for p in PASSES}
 # Relative bound on a pass's frame mean (of the pass's mean magnitude), from the measured
 # spread between Cycles seeds (at most 1.2 % at 128 samples, less at SAMPLES) with margin;
@@ -58,7 +57,7 @@ def _render(path: Path, engine: str, blend: str, seed: int = 1) -> tuple[dict, d
     make_unbiased(scene)
     scene.cycles.samples, scene.cycles.seed = SAMPLES, seed
     layer = scene.view_layers[0]
-    for p in COMPARED:
+    for p in PASSES:
         setattr(layer, p.setting, True)
     layer.use_pass_cryptomatte_object = layer.use_pass_cryptomatte_material = True
     layer.use_pass_cryptomatte_asset = True
@@ -88,7 +87,7 @@ def _pass(layers: dict, name: str, channels: str = "rgba") -> np.ndarray:
 
 
 def _cases():
-    for info in COMPARED + list(DENOISING_PASSES):
+    for info in PASSES + DENOISING_PASSES:
         yield pytest.param(info, id=info.name)
 
 

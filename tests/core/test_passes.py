@@ -15,6 +15,9 @@
 * A textured world (Environment Texture, sampled with its map): the sky's
   radiance goes to Environment and the denoising albedo, its light on a plane to
   Diffuse Direct, and the light passes still recompose Combined.
+* Ambient occlusion: a floor under a square ceiling sees the sky in 1 minus the
+  ceiling's form factor (cosine-weighted), times the floor's alpha; beyond the AO
+  distance nothing occludes.
 """
 import math
 
@@ -215,7 +218,8 @@ def test_data_passes_of_a_plane_seen_from_above():
     # lower-right half and its mirror; the third channel is 1 wherever a UV was written.
     uv = s.pass_image("UV")
     assert np.all(uv[..., 2] == 1.0) and 0.4 < uv[..., 0].mean() < 0.6
-    assert s.pass_image("Vector").max() == 0.0 and s.pass_image("Ambient Occlusion").max() == 0.0
+    assert s.pass_image("Vector").max() == 0.0
+    np.testing.assert_allclose(s.pass_image("Ambient Occlusion"), 1.0)    # nothing above
     # A sun of 2 W/m^2 at normal incidence: radiance albedo x 2/pi, diffuse light 2/pi.
     np.testing.assert_allclose(s.pass_image("Diffuse Direct"), 2.0 / math.pi, rtol=1e-6)
     for name in ("Glossy Direct", "Transmission Direct", "Diffuse Indirect", "Emission"):
@@ -284,9 +288,12 @@ def test_no_pass_costs_no_film_memory_or_path_buffers():
     plain = RenderSession(_plane_scene())
     assert plain.film.passes.size == 1 and plain.pass_names() == []
     data = RenderSession(_plane_scene(enabled=("Depth", "Normal")))
-    assert data.film.passes.shape == (64, 4) and not data._path_passes
+    # The workers' buffers: (classic integrator, per-path pass buffers, a second shadow ray).
+    assert data.film.passes.shape == (64, 4) and data._buffers == (False, False, False)
     light = RenderSession(_plane_scene(enabled=("Diffuse Direct",)))
-    assert light.film.passes.shape == (64, 6) and light._path_passes   # direct + colour
+    assert light.film.passes.shape == (64, 6) and light._buffers == (False, True, False)
+    ao = RenderSession(_plane_scene(enabled=("Ambient Occlusion",)))
+    assert ao.film.passes.shape == (64, 3) and ao._buffers == (False, False, True)
 
 
 # -- Cryptomatte ---------------------------------------------------------------------------------
@@ -380,3 +387,50 @@ def test_denoised_image_keeps_alpha_and_needs_no_guides():
     out = s.denoised()
     assert out.shape == (8, 8, 4) and np.all(out[..., 3] == s.image()[..., 3])
     np.testing.assert_allclose(out[..., :3].mean(), s.image()[..., :3].mean(), rtol=0.05)
+
+
+def _corner_form_factor(x, y):
+    """Form factor from a point to a parallel X x Y rectangle (in units of its height) with
+    one corner straight above it."""
+    ax, ay = math.sqrt(1.0 + x * x), math.sqrt(1.0 + y * y)
+    return (x / ax * math.atan(y / ax) + y / ay * math.atan(x / ay)) / (2.0 * math.pi)
+
+
+@pytest.mark.parametrize("alpha", [1.0, 0.7])
+@pytest.mark.parametrize("distance", [0.9, 10.0])
+def test_ambient_occlusion_under_a_square_ceiling(alpha, distance):
+    """A floor under a 2 x 2 ceiling at height 1, seen (orthographic, 8 x 8 pixels over 2 cm)
+    from between them straight below the ceiling's centre: cosine-weighted AO rays meet
+    the ceiling with the probability of its form factor, 4 F(1, 1) = 0.5541 (a uniform
+    hemisphere would give 0.216), so the pass is alpha x 0.4459; with an AO distance
+    below the height it is alpha.  A floor mixing Transparent at 0.3 has alpha 0.7 (were the
+    ceiling so too, 0.3 of the light it blocks would pass: the pass would be 0.428).  The
+    independent sampler makes each sample a Bernoulli trial: the bound is 4.4 of its
+    standard errors."""
+    floor = Geometry.from_triangles(grid_plane(40.0), material_index=np.zeros(2, int),
+                                    object_names=["Floor"])
+    ceiling = Geometry.from_triangles(grid_plane(2.0, z=1.0), material_index=np.ones(2, int),
+                                      object_names=["Ceiling"])
+    paint = Material(name="Paint", nodes=[
+        ShaderNode("BsdfDiffuse", {"Color": (0.5, 0.5, 0.5)}),
+        ShaderNode("BsdfTransparent", {}),
+        ShaderNode("MixShader", {"Fac": 1.0 - alpha, "Shader": Link(0, "BSDF"),
+                                 "Shader_001": Link(1, "BSDF")})], surface=Link(2, "Shader"))
+    res, samples = 8, 256
+    scene = SceneDescription(
+        geometry=Geometry.concatenate([floor, ceiling]), materials=[paint, Material(name="Opaque")],
+        lights=[], camera=Camera(matrix_world=look_down(0.5), type="ORTHO", ortho_scale=0.02,
+                                 clip_start=0.01, clip_end=100.0),
+        world=World(color=(0.0, 0.0, 0.0)),
+        film=Film(width=res, height=res),
+        integrator=Integrator(samples=samples, max_bounces=0, sampler="independent"),
+        passes=RenderPasses(enabled=("Ambient Occlusion",), ao_distance=distance))
+    ao = render(scene).pass_image("Ambient Occlusion").astype(np.float64)
+    assert np.all(ao[..., 0] == ao[..., 2])
+    if distance < 1.0:
+        np.testing.assert_allclose(ao, alpha, rtol=1e-6)
+        return
+    open_sky = 1.0 - 4.0 * _corner_form_factor(1.0, 1.0)
+    n = res * res * samples
+    se = alpha * math.sqrt(open_sky * (1.0 - open_sky) / n)
+    assert abs(ao.mean() - alpha * open_sky) < 4.4 * se, (ao.mean(), alpha * open_sky, se)

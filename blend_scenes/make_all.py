@@ -40,6 +40,7 @@ SCENES = (
     "material_nodes",
     "material_suzanne",
     "material_rough_glass",
+    "material_anisotropic",
     "caustics",
     "caustics_point",
     "texture_procedural",

@@ -91,7 +91,9 @@ from .kernels.svm.nodes import (
     SHADER_ROUTING,
     SIZE,
     TABLE,
+    TANGENT,
     TANGENT_PREFIX,
+    UNLINKED,
     VALUE_NODES,
     VECTOR,
 )
@@ -106,6 +108,10 @@ DEFAULT_COLOR_ATTRIBUTE = ".default color"
 # the mesh, which is not rendered: warned at export).
 BUMP_METHODS = ("BUMP", "BOTH")
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
+# A closure's anisotropy input and the largest constant value at which the closure ignores
+# its tangent (kernels/svm/closure_nodes.py, as Cycles' svm_node_closure_bsdf): the implicit
+# tangent is only computed where it is used.
+_ANISOTROPY = {"BsdfPrincipled": ("Anisotropic", 0.0), "BsdfGlossy": ("Anisotropy", 1e-4)}
 # Inputs whose constant values decide whether a closure node can emit or let light through.
 _EMISSION_INPUTS = {"Emission": ("Color", "Strength"),
                     "BsdfPrincipled": ("Emission Color", "Emission Strength")}
@@ -272,7 +278,9 @@ class _Compiler:
             if node.type in VALUE_NODES:
                 raise self.error(f"the output of {node.type} is not a shader")
             raise self.error(f"shader node {node.type} is not supported")
-        values = [self.input(node, socket) for socket in spec.inputs]
+        isotropic = _isotropic(node)
+        values = [Value(VECTOR, UNLINKED) if isotropic and node.inputs.get(socket.name, socket.default) == TANGENT
+                  else self.input(node, socket) for socket in spec.inputs]
         base = self.block(spec.inputs, values)
         self.program.ops.append([OP_CLOSURE, spec.code, base, weight_reg])
         # What emits or lets light through differently from point to point (or from ray to
@@ -452,10 +460,21 @@ class _Compiler:
         return Value(to, reg=out)
 
 
+def _isotropic(node) -> bool:
+    """Whether a closure node's constant anisotropy leaves its tangent unused."""
+    name, cutoff = _ANISOTROPY.get(node.type, (None, 0.0))
+    value = node.inputs.get(name, 0.0)
+    if isinstance(value, Link):
+        return False
+    a = float(np.asarray(value, float).ravel()[0])
+    return a <= cutoff if node.type == "BsdfPrincipled" else abs(a) <= cutoff
+
+
 # Nodes that read a per-corner attribute: type -> (prefix of the attribute's name, the
 # property naming it); the attribute's offset goes to their "prop:attribute" input.
 _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map"),
-                      "VertexColor": ("", "layer_name"), "NormalMap": (TANGENT_PREFIX, "uv_map")}
+                      "VertexColor": ("", "layer_name"), "NormalMap": (TANGENT_PREFIX, "uv_map"),
+                      "Tangent": (TANGENT_PREFIX, "uv_map")}
 
 
 # What the compiler shows a node it evaluates ahead of time: no point, no scene (and, public,

@@ -7,10 +7,13 @@ installed sources is not ready, so that the first F12 finds them compiled::
 
     python -m mcengine.warmup        # prints the seconds taken; exit 0 when ready
 
-It renders one sample of one pixel of a tiny scene with the default
-integrator (every shader node and closure is compiled with the shader
+It renders one sample of one pixel of a tiny scene with each integrator, the
+default one first (every shader node and closure is compiled with the shader
 evaluator, whatever the scene uses), then marks the cache ready
-(``jit.cache_is_ready``).  The other integrators compile at their first use.
+(``jit.cache_is_ready``).  Compiling every integrator here matters beyond the
+wait: numba compiling inside a Blender process where Cycles has rendered can
+crash that process (seen with bpy 5.0.1: a segfault in the next render), so a
+user's first Whitted render after a Cycles one must find its kernels compiled.
 """
 from __future__ import annotations
 
@@ -25,8 +28,8 @@ from .scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDes
 __all__ = ["warm_up_scene", "compile_kernels", "main"]
 
 
-def warm_up_scene() -> SceneDescription:
-    """One quad under a point lamp, seen by a one-pixel camera: one sample."""
+def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
+    """One quad under a point lamp, seen by a one-pixel camera: one sample of ``integrator``."""
     quad = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
                     np.float64)
     camera = np.eye(4)
@@ -37,14 +40,15 @@ def warm_up_scene() -> SceneDescription:
         geometry=Geometry.from_triangles(quad), materials=[Material()],
         lights=[Light(type="POINT", matrix_world=lamp, radius=0.1)],
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
-        integrator=Integrator(name=integrators.DEFAULT, samples=1))
+        integrator=Integrator(name=integrator, samples=1))
 
 
 def compile_kernels() -> float:
-    """Compile (or load) the default integrator's kernels; seconds taken."""
+    """Compile (or load) every integrator's kernels, the default one first; seconds taken."""
     from .session import RenderSession
     start = time.perf_counter()
-    RenderSession(warm_up_scene(), threads=1).run()
+    for name in sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT):
+        RenderSession(warm_up_scene(name), threads=1).run()
     jit.mark_cache_ready()
     return time.perf_counter() - start
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 
-from mcengine.kernels.svm.nodes import Socket
+from mcengine.kernels.svm.nodes import TANGENT, Socket
 from mcengine.scene import Link, Material, ShaderNode
 
 from .shader_graph import GraphReader, label, source
@@ -59,9 +59,10 @@ class MaterialTable:
 
     def tangent_maps(self, indices) -> set:
         """UV maps whose tangents the materials at ``indices`` read (Normal Map nodes in
-        tangent space; "" is the default UV map)."""
+        tangent space, Tangent nodes along a UV map; "" is the default UV map)."""
         return {str(node.props.get("uv_map", "")) for i in set(indices) for node in self.materials[i].nodes
-                if node.type == "NormalMap" and str(node.props.get("space", "TANGENT")) == "TANGENT"}
+                if node.type == "NormalMap" and str(node.props.get("space", "TANGENT")) == "TANGENT"
+                or node.type == "Tangent" and str(node.props.get("direction_type")) == "UV_MAP"}
 
     def index(self, material) -> int:
         """Index of a Blender material (None: the default surface), converting it once."""
@@ -148,18 +149,13 @@ class _MaterialGraph(GraphReader):
         self._check(node, copied.type, copied.inputs)
         return copied
 
-    def _in(self, node, ident, kind, groups):
+    def _in(self, node, ident, kind, groups, default=None):
         sockets = {s.identifier: s for s in node.inputs}
-        return self.input(node, sockets[ident], Socket(ident, kind, None), groups)
+        return self.input(node, sockets[ident], Socket(ident, kind, default), groups)
 
     def _check(self, node, kind, inputs) -> None:
         """Note what the closure model renders differently from Cycles."""
         lbl = label(node)
-        tangent = inputs.get("Tangent")
-        aniso = inputs.get("Anisotropic", inputs.get("Anisotropy", 0.0))
-        if aniso and (tangent is None or not isinstance(tangent, Link) and not any(tangent)):
-            self.note(f"{lbl} anisotropy along the default (radial) tangent", "anisotropy",
-                      f"{lbl} rendered isotropic")
         thin = inputs.get("Thin Film Thickness", 0.0)
         if isinstance(thin, Link) or thin > _THIN_FILM_CUTOFF:
             self.note(f"{lbl} thin film", "thin film", "thin-film interference ignored")
@@ -177,7 +173,7 @@ class _MaterialGraph(GraphReader):
                                 ("Rotation", "Anisotropic Rotation", "float"),
                                 ("Normal", "Normal", "vector"), ("Tangent", "Tangent", "vector"),
                                 ("Thin Film Thickness", "Thin Film Thickness", "float")):
-            value = self._in(node, ident, kind, groups)
+            value = self._in(node, ident, kind, groups, TANGENT if ident == "Tangent" else None)
             if value is not None:
                 inputs[to] = value
         if isinstance(inputs.get("Anisotropic"), float):

@@ -232,7 +232,7 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         triangles = _corner_vertices(me)[loops].reshape(t, 3)
         vertices = _get(me.vertices, "co", np.float32, len(me.vertices) * 3).reshape(-1, 3)
         corners = loops.reshape(t, 3)
-        normals = _shading_normals(me, corners, triangles, polygons)
+        normals = _shading_normals(me, vertices, corners, triangles, polygons)
         uv_layer = _render_uv_layer(me)
         slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
@@ -432,19 +432,24 @@ def _polygon_material_index(me):
     return _get(attr.data, "value", np.int32, len(me.polygons))
 
 
-def _shading_normals(me, corners, triangles, polygons) -> CornerTable:
-    """Shading normals of the triangle corners, the values ``corner_normals`` gives.
+def _shading_normals(me, vertices, corners, triangles, polygons) -> CornerTable:
+    """Shading normals of the triangle corners, as Cycles shades them.
 
-    ``corner_normals`` is read only when the normals really vary per corner
-    (sharp edges, custom normals); smooth meshes use the vertex normals and flat
-    ones the face normals, which are the same values at a fraction of the cost.
+    A smooth mesh has its vertex normals, a mesh with sharp edges or custom normals
+    its ``corner_normals``.  A flat mesh has each triangle's own geometric normal, as
+    Cycles shades flat triangles (measured on a non-planar quad: Cycles' Normal is its
+    True Normal, not the polygon's normal); a degenerate triangle keeps its polygon's.
     """
     if me.normals_domain == "POINT":
         return CornerTable(_get(me.vertex_normals, "vector", np.float32,
                                 len(me.vertices) * 3).reshape(-1, 3), triangles)
     if me.normals_domain == "FACE":
-        return CornerTable(_get(me.polygon_normals, "vector", np.float32,
-                                len(me.polygons) * 3).reshape(-1, 3), _face_corners(polygons))
+        p = vertices.astype(np.float64)[triangles]
+        flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        length = np.linalg.norm(flat, axis=1, keepdims=True)
+        polygon = _get(me.polygon_normals, "vector", np.float32, len(me.polygons) * 3).reshape(-1, 3)
+        flat = np.where(length > 0.0, flat / np.where(length > 0.0, length, 1.0), polygon[polygons])
+        return CornerTable(flat.astype(np.float32), _face_corners(np.arange(len(triangles))))
     return CornerTable(_get(me.corner_normals, "vector", np.float32,
                             len(me.loops) * 3).reshape(-1, 3), corners)
 
@@ -535,11 +540,6 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
         return ""
     t = len(triangles)
     corner_normals = normals.corners(0, t).reshape(-1, 3)
-    if me.normals_domain == "FACE":
-        p = vertices.astype(np.float64)[triangles]
-        flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-30)
-        corner_normals = np.repeat(flat, 3, axis=0)
     tm = bpy.data.meshes.new(".mcengine tangents")
     try:
         tm.vertices.add(len(vertices))

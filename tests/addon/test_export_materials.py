@@ -46,8 +46,9 @@ def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
     m, warnings = exported(fake_session, mat)
     node = surface(m)
     assert node.type == "BsdfPrincipled" and node.props["distribution"] == "GGX"
+    # Every input, but the Tangent: left to the core's compiler, as Cycles links its default.
     assert set(node.inputs) == {socket.name for socket in INPUTS["BsdfPrincipled"]
-                                if not socket.name.startswith("prop:")}
+                                if not socket.name.startswith("prop:")} - {"Tangent"}
     assert node.inputs["Base Color"] == pytest.approx((0.2, 0.4, 0.6))
     assert (node.inputs["Roughness"], node.inputs["Metallic"], node.inputs["Coat Weight"]) == \
         pytest.approx((0.3, 0.25, 0.5))
@@ -188,12 +189,24 @@ def test_metallic_node_is_the_principled_conductor(scene, fake_session):
 
 
 def test_what_is_rendered_differently_is_warned_once(scene, fake_session):
-    mat = principled("Skin", Subsurface_Weight=0.5, Anisotropic=0.5, Thin_Film_Thickness=300.0)
+    mat = principled("Skin", Subsurface_Weight=0.5, Thin_Film_Thickness=300.0)
     _, warnings = exported(fake_session, mat)
     assert len(warnings) == 1
-    for part in ("anisotropy along the default (radial) tangent", "thin film",
-                 "subsurface weight 0.5", "rendered isotropic", "subsurface rendered as diffuse"):
+    for part in ("thin film", "subsurface weight 0.5", "subsurface rendered as diffuse"):
         assert part in warnings[0]
+
+
+@pytest.mark.parametrize("bl_idname,anisotropy", [("ShaderNodeBsdfPrincipled", "Anisotropic"),
+                                                  ("ShaderNodeBsdfMetallic", "Anisotropy"),
+                                                  ("ShaderNodeBsdfAnisotropic", "Anisotropy")])
+def test_anisotropy_along_the_default_tangent_is_not_warned(scene, fake_session, bl_idname, anisotropy):
+    """An unlinked Tangent is left out: the core links Cycles' default there (Geometry's
+    radial tangent about object Z)."""
+    mat = bpy.data.materials.new("Brushed")
+    node = replace_surface(mat, bl_idname)
+    node.inputs[anisotropy].default_value = 0.5
+    m, warnings = exported(fake_session, mat)
+    assert "Tangent" not in surface(m).inputs and warnings == []
 
 
 def test_mix_and_add_shaders_are_links_between_nodes(scene, fake_session):

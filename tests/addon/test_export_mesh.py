@@ -389,6 +389,24 @@ def test_normal_maps_get_the_tangents_of_their_uv_map(scene, fake_session):
     np.testing.assert_allclose(np.abs(tangent[:, 3]), 1.0)
 
 
+def test_tangent_nodes_along_a_uv_map_get_its_tangents(scene, fake_session):
+    """A Tangent node along a UV map reads the same tangents; a radial one none."""
+    ob = new_mesh_object("Quad", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+    ob.data.uv_layers.new(name="Plain").uv.foreach_set("vector", [0, 0, 1, 0, 1, 1, 0, 1])
+    mat = bpy.data.materials.new("Brushed")
+    nt = mat.node_tree
+    along, radial = nt.nodes.new("ShaderNodeTangent"), nt.nodes.new("ShaderNodeTangent")
+    along.direction_type, along.uv_map = "UV_MAP", "Plain"
+    nt.links.new(along.outputs["Tangent"], nt.nodes["Principled BSDF"].inputs["Tangent"])
+    nt.links.new(radial.outputs["Tangent"], nt.nodes["Principled BSDF"].inputs["Normal"])
+    ob.data.materials.append(mat)
+    desc = export_scene(fake_session)
+    assert set(k for k in desc.geometry.attributes if k.startswith("tangent:")) == {"tangent:Plain"}
+    nodes = [n for m in desc.materials for n in m.nodes if n.type == "Tangent"]
+    assert sorted(n.props["direction_type"] for n in nodes) == ["RADIAL", "UV_MAP"]
+    assert not any("tangent" in w for w in desc.warnings)
+
+
 def test_normal_maps_on_ngons_get_tangents(scene, fake_session):
     """Tangents come from the triangles, so n-gons (which calc_tangents refuses) have them."""
     ring = [(math.cos(a), math.sin(a), 0) for a in np.linspace(0, 2 * math.pi, 7)[:-1]]

@@ -169,8 +169,6 @@ def render_cases(cases: dict) -> dict:
         chunk = {name: cases[name] for name in names[start:start + per_scene]}
         scene, rows, cols = _scene(chunk)
         images = render_both(scene)
-        if __import__('os').environ.get('NODE_DEBUG'):
-            np.save(f'/tmp/nodes_{start}.npy', np.stack([images['CYCLES'], images['MCENGINE']]))
         for k, name in enumerate(chunk):
             r, c = divmod(k, cols)
             sl = (slice(r * CELL + 4, (r + 1) * CELL - 4), slice(c * CELL + 4, (c + 1) * CELL - 4))

@@ -1,7 +1,7 @@
 """Input nodes: what the shading point offers the graph (kernel/svm/tex_coord.h, geometry.h,
 attribute.h, vertex_color.h, fresnel.h, light_path.h, camera.h, value.h).
 
-Texture Coordinate, UV Map, Attribute, Color Attribute, Geometry, Object
+Texture Coordinate, UV Map, Attribute, Color Attribute, Geometry, Tangent, Object
 Info, Camera Data, Fresnel, Layer Weight and Light Path read the point
 (``ShadingData``: its path flags, ray length and bounce counts for Light
 Path) and the scene's per-corner attributes and per-object data
@@ -28,7 +28,7 @@ from .data import (
     OBJ_TEXSPACE_SIZE,
 )
 from .math_nodes import safe_normalize
-from .nodes import NODES, OFFSETS
+from .nodes import AXIS_X, AXIS_Y, AXIS_Z, DIRECTION_UV_MAP, NODES, OFFSETS
 
 _VALUE = NODES["Value"].code
 _RGB = NODES["RGB"].code
@@ -54,6 +54,10 @@ _LW_NORMAL = OFFSETS["LayerWeight"]["Normal"]
 _OI_MATERIAL_INDEX = OFFSETS["ObjectInfo"]["prop:material_index"]
 _VC_OFFSET = OFFSETS["VertexColor"]["prop:attribute"]
 _VC_SIZE = OFFSETS["VertexColor"]["prop:attribute_size"]
+_TANGENT = NODES["Tangent"].code
+_TG_DIRECTION = OFFSETS["Tangent"]["prop:direction_type"]
+_TG_AXIS = OFFSETS["Tangent"]["prop:axis"]
+_TG_ATTRIBUTE = OFFSETS["Tangent"]["prop:attribute"]
 _RANDOM_SCALE = 1.0 / 4294967295.0       # Object Info Random: the object's 32-bit random id
 
 
@@ -68,7 +72,9 @@ def eval_input_node(code, regs, b, c, sd, tex):
     elif code == _ATTRIBUTE:
         attribute_node(regs, b, c, sd, tex)
     elif code == _GEOMETRY:
-        geometry(regs, c, sd)
+        geometry(regs, c, sd, tex)
+    elif code == _TANGENT:
+        tangent_node(regs, b, c, sd, tex)
     elif code == _FRESNEL or code == _LAYER_WEIGHT:
         fresnel_nodes(code, regs, b, c, sd)
     elif code == _LIGHT_PATH:
@@ -186,11 +192,7 @@ def tex_coord(regs, b, c, sd, tex):
     if ob >= 0 and sd.prim >= 0:
         row = objects[ob]
         ox, oy, oz = transform_point(row, OBJ_INVERSE, px, py, pz)
-        lx, ly, lz = row[OBJ_TEXSPACE_LOC], row[OBJ_TEXSPACE_LOC + 1], row[OBJ_TEXSPACE_LOC + 2]
-        sx, sy, sz = row[OBJ_TEXSPACE_SIZE], row[OBJ_TEXSPACE_SIZE + 1], row[OBJ_TEXSPACE_SIZE + 2]
-        gx = (ox - lx) / (2.0 * sx) + 0.5
-        gy = (oy - ly) / (2.0 * sy) + 0.5
-        gz = (oz - lz) / (2.0 * sz) + 0.5
+        gx, gy, gz = texture_space(row, ox, oy, oz)
         onx, ony, onz = normal_to_object(row, nx, ny, nz)
     if regs[b + _TC_USE_OBJECT] != 0.0:
         ox, oy, oz = transform_point(regs, b + _TC_INVERSE, px, py, pz)
@@ -220,6 +222,60 @@ def tex_coord(regs, b, c, sd, tex):
 
 
 @device
+def texture_space(row, ox, oy, oz):
+    """An object-space point in the object's texture space (its Generated coordinates):
+    the texture-space box of the object's row of ``TextureData.objects`` maps to the unit cube."""
+    lx, ly, lz = row[OBJ_TEXSPACE_LOC], row[OBJ_TEXSPACE_LOC + 1], row[OBJ_TEXSPACE_LOC + 2]
+    sx, sy, sz = row[OBJ_TEXSPACE_SIZE], row[OBJ_TEXSPACE_SIZE + 1], row[OBJ_TEXSPACE_SIZE + 2]
+    return (ox - lx) / (2.0 * sx) + 0.5, (oy - ly) / (2.0 * sy) + 0.5, (oz - lz) / (2.0 * sz) + 0.5
+
+
+@device
+def surface_tangent(row, sd, tx, ty, tz):
+    """An object-space tangent direction at the point, in world space and perpendicular to
+    the shading normal: transformed as a normal, then N x normalize(T x N), as Cycles ends
+    svm_node_tangent and primitive_tangent (zero stays zero)."""
+    tx, ty, tz = normal_to_world(row, tx, ty, tz)
+    nx, ny, nz = sd.nx, sd.ny, sd.nz
+    cx, cy, cz = safe_normalize(ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx)
+    return ny * cz - nz * cy, nz * cx - nx * cz, nx * cy - ny * cx
+
+
+@device
+def radial_tangent(sd, tex, axis):
+    """The tangent of the circle about an object axis through the centre of the object's
+    texture space, at the point (Tangent node, radial; Geometry's Tangent is the one about Z);
+    zero off a mesh."""
+    if sd.obj < 0 or sd.prim < 0:
+        return 0.0, 0.0, 0.0
+    row = tex.objects[sd.obj]
+    ox, oy, oz = transform_point(row, OBJ_INVERSE, sd.px, sd.py, sd.pz)
+    gx, gy, gz = texture_space(row, ox, oy, oz)
+    if axis == AXIS_X:
+        tx, ty, tz = 0.0, 0.5 - gz, gy - 0.5
+    elif axis == AXIS_Y:
+        tx, ty, tz = 0.5 - gz, 0.0, gx - 0.5
+    else:
+        tx, ty, tz = 0.5 - gy, gx - 0.5, 0.0
+    return surface_tangent(row, sd, tx, ty, tz)
+
+
+@device
+def tangent_node(regs, b, c, sd, tex):
+    """Tangent: radial about the chosen object axis, or the UV map's (MikkTSpace) tangent;
+    zero where the map has no tangents."""
+    if regs[b + _TG_DIRECTION] == DIRECTION_UV_MAP:
+        off = int(regs[b + _TG_ATTRIBUTE])
+        tx = ty = tz = 0.0
+        if off >= 0 and sd.obj >= 0 and sd.prim >= 0:
+            x, y, z, _w = attribute(tex, sd, off, 3)
+            tx, ty, tz = surface_tangent(tex.objects[sd.obj], sd, x, y, z)
+    else:
+        tx, ty, tz = radial_tangent(sd, tex, int(regs[b + _TG_AXIS]))
+    _store3(regs, c, tx, ty, tz)
+
+
+@device
 def attribute_node(regs, b, c, sd, tex):
     """Attribute (geometry type): Color, Vector, Fac, Alpha of a per-corner attribute."""
     off = int(regs[b + _ATTR_OFFSET])
@@ -238,12 +294,13 @@ def attribute_node(regs, b, c, sd, tex):
 
 
 @device
-def geometry(regs, c, sd):
-    """Geometry: Position, Normal, Tangent (not yet: zero), True Normal, Incoming, Parametric,
-    Backfacing, Pointiness (not yet: 0.5) and Random Per Island (not yet: 0)."""
+def geometry(regs, c, sd, tex):
+    """Geometry: Position, Normal, Tangent (radial about object Z), True Normal, Incoming,
+    Parametric, Backfacing, Pointiness (not yet: 0.5) and Random Per Island (not yet: 0)."""
     _store3(regs, c, sd.px, sd.py, sd.pz)
     _store3(regs, c + 3, sd.nx, sd.ny, sd.nz)
-    _store3(regs, c + 6, 0.0, 0.0, 0.0)
+    tx, ty, tz = radial_tangent(sd, tex, AXIS_Z)
+    _store3(regs, c + 6, tx, ty, tz)
     _store3(regs, c + 9, sd.ngx, sd.ngy, sd.ngz)
     _store3(regs, c + 12, sd.wox, sd.woy, sd.woz)
     _store3(regs, c + 15, 1.0 - sd.u - sd.v, sd.u, 0.0)

@@ -173,6 +173,14 @@ SPACE_BLENDER_WORLD = 4
 SPACES = {"TANGENT": SPACE_TANGENT, "OBJECT": SPACE_OBJECT, "WORLD": SPACE_WORLD,
           "BLENDER_OBJECT": SPACE_BLENDER_OBJECT, "BLENDER_WORLD": SPACE_BLENDER_WORLD}
 
+# Tangent node: ``direction_type`` (radial about an object axis, or a UV map's tangent) and
+# the ``axis`` of the radial one.
+DIRECTION_RADIAL = 0
+DIRECTION_UV_MAP = 1
+DIRECTION_TYPES = {"RADIAL": DIRECTION_RADIAL, "UV_MAP": DIRECTION_UV_MAP}
+AXIS_X, AXIS_Y, AXIS_Z = 0, 1, 2
+AXES = {"X": AXIS_X, "Y": AXIS_Y, "Z": AXIS_Z}
+
 ENUMS = {
     "distribution": DISTRIBUTIONS,
     "operation": OPERATIONS,
@@ -193,6 +201,8 @@ ENUMS = {
     "wave_profile": WAVE_PROFILES,
     "space": SPACES,
     "convert_from": TRANSFORM_SPACES,
+    "direction_type": DIRECTION_TYPES,
+    "axis": AXES,
     "convert_to": TRANSFORM_SPACES,
     "interpolation": INTERPOLATIONS,
     "extension": EXTENSIONS,
@@ -203,7 +213,7 @@ ENUMS = {
 
 WHITE = (1.0, 1.0, 1.0)
 GREY = (0.8, 0.8, 0.8)
-UNLINKED = (0.0, 0.0, 0.0)   # a Normal or Tangent input nothing is linked to: the geometry's
+UNLINKED = (0.0, 0.0, 0.0)   # a Normal input nothing is linked to: the shading normal's
 IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)   # a 3 x 4 matrix
 
 # Defaults of texture coordinate inputs that Cycles fills from the shading point when
@@ -212,8 +222,9 @@ IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)   # a 3 
 GENERATED = "generated"
 UV = "uv"
 POSITION = "position"          # the point (world shaders: the ray direction)
+TANGENT = "tangent"            # the radial tangent about object Z (Geometry's Tangent)
 IMPLICIT = {GENERATED: ("TexCoord", "Generated"), UV: ("TexCoord", "UV"),
-            POSITION: ("NewGeometry", "Position")}
+            POSITION: ("NewGeometry", "Position"), TANGENT: ("NewGeometry", "Tangent")}
 
 # Baked tables of the ColorRamp and curve nodes: Cycles samples them at RAMP_TABLE_SIZE + 1
 # evenly spaced positions (blender/util.h: colorramp_to_array, curvemapping_*_to_array).
@@ -259,7 +270,7 @@ CLOSURES = {
         _f("Alpha", 1.0), _v("Normal"), _f("Diffuse Roughness", 0.0),
         _f("Subsurface Weight", 0.0), _v("Subsurface Radius", (1.0, 0.2, 0.1)),
         _f("Subsurface Scale", 0.05), _f("Specular IOR Level", 0.5), _c("Specular Tint", WHITE),
-        _f("Anisotropic", 0.0), _f("Anisotropic Rotation", 0.0), _v("Tangent"),
+        _f("Anisotropic", 0.0), _f("Anisotropic Rotation", 0.0), _v("Tangent", TANGENT),
         _f("Transmission Weight", 0.0), _f("Coat Weight", 0.0), _f("Coat Roughness", 0.03),
         _f("Coat IOR", 1.5), _c("Coat Tint", WHITE), _v("Coat Normal"),
         _f("Sheen Weight", 0.0), _f("Sheen Roughness", 0.5), _c("Sheen Tint", WHITE),
@@ -268,7 +279,7 @@ CLOSURES = {
         _p("distribution", DIST_MULTI_GGX)), _BSDF, False),
     "BsdfDiffuse": NodeSpec(2, (_c("Color", GREY), _f("Roughness", 0.0), _v("Normal")), _BSDF, False),
     "BsdfGlossy": NodeSpec(3, (_c("Color", GREY), _f("Roughness", 0.5), _f("Anisotropy", 0.0),
-                               _f("Rotation", 0.0), _v("Normal"), _v("Tangent"),
+                               _f("Rotation", 0.0), _v("Normal"), _v("Tangent", TANGENT),
                                _p("distribution", DIST_MULTI_GGX)), _BSDF, False),
     "BsdfGlass": NodeSpec(4, (_c("Color", WHITE), _f("Roughness", 0.0), _f("IOR", 1.5),
                               _v("Normal"), _f("Thin Film Thickness", 0.0),
@@ -341,6 +352,9 @@ VALUE_NODES = {
                                      _f("View Distance", 0.0)), False),
     "VertexColor": NodeSpec(112, (_p("attribute", -1), _p("attribute_size", 0)),
                             (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), False),
+    # Tangent: "prop:attribute" is the UV map's tangent attribute (TANGENT_PREFIX)
+    "Tangent": NodeSpec(113, (_p("direction_type", DIRECTION_RADIAL), _p("axis", AXIS_Z),
+                              _p("attribute", -1)), (_v("Tangent", UNLINKED),), False),
     # -- math family: converters (svm/math_nodes.py)
     "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
                            _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),

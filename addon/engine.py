@@ -154,7 +154,8 @@ class MCEngine(bpy.types.RenderEngine):
         if render is None:
             # Looked up at each render, so that tests and the command line can replace it.
             # On the render's thread: it waits for a background kernel compile to end.
-            render = ViewportRender(lambda desc: (warmup.wait(lambda: False),
+            render = ViewportRender(lambda desc: (warmup.wait(lambda: False,
+                                                              integrator=desc.integrator.name),
                                                   session_factory(desc))[1])
             self._mcengine_viewport = render
         return render
@@ -189,8 +190,9 @@ class MCEngine(bpy.types.RenderEngine):
         for warning in () if self.is_preview else exported.scene.warnings:
             self.report({"WARNING"}, warning)
         # Kernels being compiled in the background since the add-on was enabled: wait for
-        # them rather than compile them twice.
-        if not warmup.wait(self.test_break, lambda line: self.update_stats("", line)):
+        # this integrator's rather than compile them twice.
+        if not warmup.wait(self.test_break, lambda line: self.update_stats("", line),
+                           integrator=exported.scene.integrator.name):
             return None, None
         # The first render after installing compiles the numba kernels (cached afterwards).
         self.update_stats("", f"Exported in {seconds:.2f} s | Preparing renderer (the first "

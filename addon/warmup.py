@@ -70,12 +70,15 @@ def status() -> str:
             f"enabled ({minutes}:{seconds:02d} so far)")
 
 
-def wait(should_stop, on_wait=None, poll: float = 0.1) -> bool:
-    """Wait while the background compile runs; False if ``should_stop()`` ended the wait.
+def wait(should_stop, on_wait=None, poll: float = 0.1, integrator: str | None = None) -> bool:
+    """Wait while the background compile runs (with ``integrator``, only until that
+    integrator's kernels are compiled: the compile goes on with the others); False if
+    ``should_stop()`` ended the wait.
 
     ``on_wait(status_line)`` is called about once a second."""
+    from mcengine.warmup import is_compiled
     last = -1
-    while running():
+    while running() and not (integrator is not None and is_compiled(integrator)):
         if should_stop():
             return False
         if on_wait is not None and int(elapsed()) != last:

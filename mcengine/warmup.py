@@ -25,7 +25,17 @@ import numpy as np
 from . import integrators, jit
 from .scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription
 
-__all__ = ["warm_up_scene", "compile_kernels", "main"]
+__all__ = ["warm_up_scene", "compile_kernels", "is_compiled", "main"]
+
+
+def _marker(integrator: str):
+    return jit.cache_folder() / f"kernels-compiled-{integrator}"
+
+
+def is_compiled(integrator: str) -> bool:
+    """True once this module has compiled ``integrator``'s kernels for these sources (a
+    render of it then only loads them, while the warm-up may go on with the others)."""
+    return _marker(integrator).exists()
 
 
 def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
@@ -49,6 +59,7 @@ def compile_kernels() -> float:
     start = time.perf_counter()
     for name in sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT):
         RenderSession(warm_up_scene(name), threads=1).run()
+        _marker(name).touch()
     jit.mark_cache_ready()
     return time.perf_counter() - start
 

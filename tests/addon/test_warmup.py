@@ -10,7 +10,8 @@ import time
 
 import pytest
 
-from mcengine import jit
+import mcengine.warmup
+from mcengine import integrators, jit
 
 
 @pytest.fixture
@@ -24,11 +25,14 @@ def warmup(addon):
 def test_warm_up_compiles_and_marks_the_cache_ready():
     marker = jit.cache_folder() / "kernels-compiled"
     marker.unlink(missing_ok=True)
-    assert not jit.cache_is_ready()
+    for name in integrators.NAMES:
+        (jit.cache_folder() / f"kernels-compiled-{name}").unlink(missing_ok=True)
+    assert not jit.cache_is_ready() and not any(map(mcengine.warmup.is_compiled, integrators.NAMES))
     done = subprocess.run([sys.executable, "-m", "mcengine.warmup"], capture_output=True,
                           text=True, timeout=1800)
     assert done.returncode == 0, done.stderr
     assert "kernels compiled in" in done.stdout and jit.cache_is_ready()
+    assert all(map(mcengine.warmup.is_compiled, integrators.NAMES))
     again = subprocess.run([sys.executable, "-m", "mcengine.warmup"], capture_output=True,
                            text=True, timeout=600)
     assert again.returncode == 0 and "already compiled" in again.stdout
@@ -70,18 +74,37 @@ def test_a_cancelled_render_stops_waiting(warmup, monkeypatch):
     assert not warmup.running()
 
 
+def test_a_render_waits_only_for_its_integrators_kernels(warmup, monkeypatch):
+    """The warm-up compiles the default integrator first: a render of it need not wait for
+    the others."""
+    _sleeper(monkeypatch, 30.0)
+    monkeypatch.setattr(mcengine.warmup, "is_compiled", lambda name: name == integrators.DEFAULT)
+    warmup.start(force=True)
+    t0 = time.monotonic()
+    assert warmup.wait(lambda: False, integrator=integrators.DEFAULT)
+    assert time.monotonic() - t0 < 1.0 and warmup.running()
+    assert not warmup.wait(lambda: time.monotonic() - t0 > 0.5, integrator="whitted")
+    assert warmup.running()
+    warmup.stop()
+
+
 def test_f12_waits_for_the_background_compile(scene, addon, fake_session, warmup, monkeypatch):
-    """The engine's render waits (showing the wait in the status bar), then renders."""
+    """The engine's render waits for its integrator's kernels (showing the wait in the status
+    bar), then renders."""
     _sleeper(monkeypatch, 1.0)
+    monkeypatch.setattr(mcengine.warmup, "is_compiled", lambda name: False)
     warmup.start(force=True)
     import bpy
-    real_wait, lines, sessions_when_done = warmup.wait, [], []
+    real_wait, lines, sessions_when_done, asked = warmup.wait, [], [], []
 
-    def spying_wait(should_stop, on_wait=None, poll=0.1):
-        done = real_wait(should_stop, lambda line: (lines.append(line), on_wait(line)), poll)
+    def spying_wait(should_stop, on_wait=None, poll=0.1, integrator=None):
+        asked.append(integrator)
+        done = real_wait(should_stop, lambda line: (lines.append(line), on_wait(line)), poll,
+                         integrator)
         sessions_when_done.append(len(fake_session))
         return done
     monkeypatch.setattr(warmup, "wait", spying_wait)
     bpy.ops.render.render()
     assert lines and lines[0].startswith("Waiting for the kernels being compiled")
+    assert asked == [integrators.DEFAULT]        # the scene's integrator: the default one
     assert sessions_when_done == [0] and len(fake_session) == 1 and not warmup.running()

@@ -424,34 +424,60 @@ def _corner_vertices(me):
     return _get(me.loops, "vertex_index", np.int32, len(me.loops))
 
 
-def _polygon_material_index(me):
-    """Material slot of every polygon, (P,) int32 (zeros when the mesh has no such attribute)."""
-    attr = me.attributes.get("material_index")
+def _polygon_values(me, name, dtype):
+    """A face attribute of every polygon, (P,) ``dtype`` (zeros without the attribute)."""
+    attr = me.attributes.get(name)
     if attr is None:
-        return np.zeros(len(me.polygons), np.int32)
-    return _get(attr.data, "value", np.int32, len(me.polygons))
+        return np.zeros(len(me.polygons), dtype)
+    return _get(attr.data, "value", dtype, len(me.polygons))
+
+
+def _polygon_material_index(me):
+    """Material slot of every polygon, (P,) int32."""
+    return _polygon_values(me, "material_index", np.int32)
 
 
 def _shading_normals(me, vertices, corners, triangles, polygons) -> CornerTable:
     """Shading normals of the triangle corners, as Cycles shades them.
 
-    A smooth mesh has its vertex normals, a mesh with sharp edges or custom normals
-    its ``corner_normals``.  A flat mesh has each triangle's own geometric normal, as
-    Cycles shades flat triangles (measured on a non-planar quad: Cycles' Normal is its
-    True Normal, not the polygon's normal); a degenerate triangle keeps its polygon's.
+    Cycles shades a smooth triangle with the vertex normals and a flat one (a face of
+    Shade Flat) with its own geometric normal; only sharp edges or custom normals make
+    it read ``corner_normals`` (it asks for Blender's normals domain with sharp faces
+    handled by the renderer).  So a mesh whose faces are all smooth, all flat, or a mix
+    of both without sharp edges gets vertex normals on its smooth triangles and the
+    triangle's normal on its flat ones (measured on a non-planar quad: Cycles' Normal is
+    its True Normal, not the polygon's normal; on a quad beside a smooth one, the
+    vertex normals include the flat face); a degenerate triangle keeps its polygon's.
     """
-    if me.normals_domain == "POINT":
-        return CornerTable(_get(me.vertex_normals, "vector", np.float32,
-                                len(me.vertices) * 3).reshape(-1, 3), triangles)
-    if me.normals_domain == "FACE":
-        p = vertices.astype(np.float64)[triangles]
-        flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        length = np.linalg.norm(flat, axis=1, keepdims=True)
-        polygon = _get(me.polygon_normals, "vector", np.float32, len(me.polygons) * 3).reshape(-1, 3)
-        flat = np.where(length > 0.0, flat / np.where(length > 0.0, length, 1.0), polygon[polygons])
-        return CornerTable(flat.astype(np.float32), _face_corners(np.arange(len(triangles))))
-    return CornerTable(_get(me.corner_normals, "vector", np.float32,
-                            len(me.loops) * 3).reshape(-1, 3), corners)
+    domain = me.normals_domain
+    if domain == "CORNER" and not me.has_custom_normals and not _any(me, "sharp_edge", "EDGE"):
+        domain = "MIXED"
+    if domain == "CORNER":
+        return CornerTable(_get(me.corner_normals, "vector", np.float32,
+                                len(me.loops) * 3).reshape(-1, 3), corners)
+    vertex = _get(me.vertex_normals, "vector", np.float32, len(me.vertices) * 3).reshape(-1, 3)
+    if domain == "POINT":
+        return CornerTable(vertex, triangles)
+    p = vertices.astype(np.float64)[triangles]
+    flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(flat, axis=1, keepdims=True)
+    polygon = _get(me.polygon_normals, "vector", np.float32, len(me.polygons) * 3).reshape(-1, 3)
+    flat = np.where(length > 0.0, flat / np.where(length > 0.0, length, 1.0), polygon[polygons])
+    own = _face_corners(np.arange(len(triangles)))
+    if domain == "FACE":
+        return CornerTable(flat.astype(np.float32), own)
+    sharp = _polygon_values(me, "sharp_face", bool)[polygons]
+    return CornerTable(np.concatenate([vertex, flat.astype(np.float32)]),
+                       np.where(sharp[:, None], len(vertex) + own, triangles))
+
+
+def _any(me, name, domain) -> bool:
+    """Whether a boolean attribute of ``domain`` is True anywhere."""
+    attr = me.attributes.get(name)
+    if attr is None or attr.domain != domain:
+        return False
+    n = len(attr.data)
+    return bool(n and _get(attr.data, "value", bool, n).any())
 
 
 def _face_corners(polygons):

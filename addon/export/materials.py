@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 
-from mcengine.kernels.svm.nodes import TANGENT, Socket
+from mcengine.kernels.svm.nodes import INPUTS, Socket
 from mcengine.scene import Link, Material, ShaderNode
 
 from .shader_graph import GraphReader, label, source
@@ -36,6 +36,8 @@ DEFAULT_GREY = (0.8, 0.8, 0.8)
 DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
 BLACK = (0.0, 0.0, 0.0)
 _THIN_FILM_CUTOFF = 0.1
+# Inputs of the Principled BSDF and their defaults (the Metallic BSDF is copied into one).
+_PRINCIPLED_DEFAULTS = {socket.name: socket.default for socket in INPUTS["BsdfPrincipled"]}
 
 
 class MaterialTable:
@@ -173,7 +175,8 @@ class _MaterialGraph(GraphReader):
                                 ("Rotation", "Anisotropic Rotation", "float"),
                                 ("Normal", "Normal", "vector"), ("Tangent", "Tangent", "vector"),
                                 ("Thin Film Thickness", "Thin Film Thickness", "float")):
-            value = self._in(node, ident, kind, groups, TANGENT if ident == "Tangent" else None)
+            # The Principled's default: an implicit one (the Tangent) stays implicit.
+            value = self._in(node, ident, kind, groups, _PRINCIPLED_DEFAULTS[to])
             if value is not None:
                 inputs[to] = value
         if isinstance(inputs.get("Anisotropic"), float):

@@ -99,11 +99,16 @@ from .kernels.svm.nodes import (
 )
 from .scene import Link, Material, SceneError, ShaderNode
 
-__all__ = ["AttributeLayout", "DEFAULT_COLOR_ATTRIBUTE", "Program", "compile_material", "ShaderTable"]
+__all__ = ["AttributeLayout", "DEFAULT_COLOR_ATTRIBUTE", "GEOMETRY_ATTRIBUTES", "Program", "compile_material",
+           "ShaderTable"]
 
 # The name under which a mesh's default colour attribute (Blender's render colour) is also
 # stored: what a Color Attribute node with no name reads, as Cycles' ATTR_STD_VERTEX_COLOR.
 DEFAULT_COLOR_ATTRIBUTE = ".default color"
+# Geometry node outputs Cycles reads as attributes it derives from the mesh at sync
+# (ATTR_STD_POINTINESS, ATTR_STD_RANDOM_PER_ISLAND): output -> the attribute's name, under
+# which the export stores what mcengine.mesh_attributes computes for the meshes that need it.
+GEOMETRY_ATTRIBUTES = {"Pointiness": ".pointiness", "Random Per Island": ".random per island"}
 # Displacement methods whose displacement Cycles turns into a bump ('BOTH' also displaces
 # the mesh, which is not rendered: warned at export).
 BUMP_METHODS = ("BUMP", "BOTH")
@@ -384,6 +389,12 @@ class _Compiler:
         for socket in spec.outputs:
             outputs[socket.name] = Value(socket.type, reg=k)
             k += SIZE[socket.type]
+        if node.type == "NewGeometry":
+            index = next((k for k, n in enumerate(self.nodes) if n is node), -1)
+            for name, attribute in GEOMETRY_ATTRIBUTES.items():
+                if (index, name) in self.linked:
+                    read = ShaderNode("Attribute", props={"attribute_name": attribute})
+                    outputs[name] = self.evaluate(read, VALUE_NODES["Attribute"])["Fac"]
         return outputs
 
     def attribute_inputs(self, node, spec, values) -> list:

@@ -26,6 +26,7 @@ import math
 
 from mcengine.kernels.svm.nodes import INPUTS, Socket
 from mcengine.scene import Link, Material, ShaderNode
+from mcengine.shaders import GEOMETRY_ATTRIBUTES
 
 from .shader_graph import GraphReader, label, source
 
@@ -55,9 +56,18 @@ class MaterialTable:
         self._index = {None: 0}
 
     def attribute_names(self) -> set:
-        """Names of the attributes the materials converted so far read (Attribute nodes)."""
-        return {str(node.props.get("attribute_name", "")) for m in self.materials
-                for node in m.nodes if node.type == "Attribute"}
+        """Names of the attributes the materials converted so far read: those of Attribute
+        nodes, and those derived from the mesh that a Geometry node's output reads
+        (``GEOMETRY_ATTRIBUTES``)."""
+        names = {str(node.props.get("attribute_name", "")) for m in self.materials
+                 for node in m.nodes if node.type == "Attribute"}
+        for m in self.materials:
+            for node in m.nodes:
+                for value in node.inputs.values():
+                    if (isinstance(value, Link) and value.socket in GEOMETRY_ATTRIBUTES
+                            and m.nodes[value.node].type == "NewGeometry"):
+                        names.add(GEOMETRY_ATTRIBUTES[value.socket])
+        return names
 
     def tangent_maps(self, indices) -> set:
         """UV maps whose tangents the materials at ``indices`` read (Normal Map nodes in

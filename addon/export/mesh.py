@@ -29,8 +29,9 @@ import numpy as np
 
 from mcengine.kernels.shading import SHADOW_TERMINATOR_OFFSET
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
+from mcengine.mesh_attributes import pointiness, random_per_island
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
-from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
+from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE, GEOMETRY_ATTRIBUTES
 
 from .settings import hash_uint2
 
@@ -236,6 +237,7 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         uv_layer = _render_uv_layer(me)
         slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
+        attributes.update(_derived_attributes(me, vertices, triangles, wanted))
         tangents_failed = _add_tangents(me, vertices, triangles, normals, tangents, uv_layer,
                                         attributes)
         texspace = _texspace(ob)
@@ -540,6 +542,23 @@ def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
     default = getattr(me.color_attributes, "default_color_name", "")
     if default in colors and default in out:
         out[DEFAULT_COLOR_ATTRIBUTE] = out[default]
+    return out
+
+
+def _derived_attributes(me, vertices, triangles, wanted) -> dict:
+    """The attributes Cycles derives from the mesh for the Geometry node that some material
+    reads (``wanted``): Pointiness per vertex, Random Per Island per triangle."""
+    out = {}
+    names = GEOMETRY_ATTRIBUTES
+    if names["Pointiness"] in wanted or names["Random Per Island"] in wanted:
+        edges = _get(me.edges, "vertices", np.int32, len(me.edges) * 2).reshape(-1, 2)
+    if names["Pointiness"] in wanted:
+        normals = _get(me.vertex_normals, "vector", np.float32, len(vertices) * 3).reshape(-1, 3)
+        values = pointiness(vertices, normals, edges)
+        out[names["Pointiness"]] = CornerTable(values[:, None], triangles)
+    if names["Random Per Island"] in wanted:
+        values = random_per_island(len(vertices), edges, triangles[:, 0])
+        out[names["Random Per Island"]] = CornerTable(values[:, None], _face_corners(np.arange(len(triangles))))
     return out
 
 

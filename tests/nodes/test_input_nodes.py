@@ -90,6 +90,25 @@ def _tilted_second_uv(ob):
     _second_uv(ob)
 
 
+def _bumpy(ob, split_lines=(("x", 0.0),)):
+    """The plane cut into a 4 x 4 grid with its inner vertices raised unevenly, and its edges
+    along ``split_lines`` (axis, value) split: the vertices there are doubled, which
+    Pointiness welds again and Random Per Island sees as the borders of separate islands."""
+    import bmesh
+    bm = bmesh.new()
+    bm.from_mesh(ob.data)
+    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=3, use_grid_fill=True)
+    heights = np.random.default_rng(7).uniform(-0.15, 0.15, len(bm.verts))
+    for v, z in zip(bm.verts, heights):
+        if max(abs(v.co.x), abs(v.co.y)) < 0.49:
+            v.co.z += z
+    on_line = [e for e in bm.edges for axis, value in split_lines
+               if all(abs(getattr(v.co, axis) - value) < 1e-6 for v in e.verts)]
+    bmesh.ops.split_edges(bm, edges=on_line)
+    bm.to_mesh(ob.data)
+    bm.free()
+
+
 def _tangent(direction, axis="Z", uv_map=""):
     def build(nt):
         node = nt.nodes.new("ShaderNodeTangent")
@@ -202,6 +221,9 @@ CASES = {
     "geometry Normal flat beside smooth, a sharp edge": (
         _geometry("Normal"), lambda ob: _flat_beside_smooth(ob, sharp_edge=True)),
     "geometry Tangent": (_geometry("Tangent"), _tilted),
+    "geometry Pointiness": (_geometry("Pointiness"), _bumpy),
+    "geometry Random Per Island": (_geometry("Random Per Island"),
+                                   lambda ob: _bumpy(ob, (("x", 0.0), ("y", 0.25)))),
     **{f"tangent radial {a}": (_tangent("RADIAL", a), _tilted) for a in "XYZ"},
     "tangent uv map default": (_tangent("UV_MAP"), _tilted),
     "tangent uv map named": (_tangent("UV_MAP", uv_map="Swapped"), _tilted_second_uv),

@@ -257,7 +257,7 @@ def surface_kinds(material) -> set:
         kind = node.type
         if kind == "BsdfDiffuse":
             kinds.add("rough diffuse" if positive("Roughness", 0.0) else "diffuse")
-        elif kind == "BsdfGlossy":
+        elif kind in ("BsdfGlossy", "BsdfMetallic"):
             kinds.add("sharp glossy" if sharp("Roughness", 0.5) else "rough glossy")
         elif kind == "BsdfGlass":
             kinds.add("sharp glass" if sharp("Roughness", 0.0) else "rough glass")

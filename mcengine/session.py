@@ -65,8 +65,10 @@ from .kernels.svm.nodes import (
     GL_ROUGHNESS,
     K_GLASS,
     K_GLOSSY,
+    K_METALLIC,
     K_PRINCIPLED,
     K_REFRACTION,
+    M_ROUGHNESS,
     P_ALPHA,
     P_COAT_ROUGHNESS,
     P_COAT_WEIGHT,
@@ -280,7 +282,8 @@ def _constant_closure_rays(kind: int, regs, b: int) -> int:
                 + int(r and regs[b + P_METALLIC] > 0.0)
                 + 2 * int(r and regs[b + P_TRANSMISSION] > 0.0)
                 + int(r))                                           # the dielectric specular
-    roughness = {K_GLOSSY: G_ROUGHNESS, K_GLASS: GL_ROUGHNESS, K_REFRACTION: R_ROUGHNESS}.get(kind)
+    roughness = {K_GLOSSY: G_ROUGHNESS, K_METALLIC: M_ROUGHNESS, K_GLASS: GL_ROUGHNESS,
+                 K_REFRACTION: R_ROUGHNESS}.get(kind)
     if roughness is not None and not smooth(abs(regs[b + roughness])):
         return 0
     return WHITTED_RAYS.get(kind, 0)

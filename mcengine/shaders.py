@@ -116,7 +116,8 @@ NO_WEIGHT = -1      # weight register of a closure that reaches the output unmix
 # A closure's anisotropy input and the largest constant value at which the closure ignores
 # its tangent (kernels/svm/closure_nodes.py, as Cycles' svm_node_closure_bsdf): the implicit
 # tangent is only computed where it is used.
-_ANISOTROPY = {"BsdfPrincipled": ("Anisotropic", 0.0), "BsdfGlossy": ("Anisotropy", 1e-4)}
+_ANISOTROPY = {"BsdfPrincipled": ("Anisotropic", 0.0), "BsdfMetallic": ("Anisotropy", 0.0),
+               "BsdfGlossy": ("Anisotropy", 1e-4)}
 # Inputs whose constant values decide whether a closure node can emit or let light through.
 _EMISSION_INPUTS = {"Emission": ("Color", "Strength"),
                     "BsdfPrincipled": ("Emission Color", "Emission Strength")}
@@ -478,7 +479,7 @@ def _isotropic(node) -> bool:
     if isinstance(value, Link):
         return False
     a = float(np.asarray(value, float).ravel()[0])
-    return a <= cutoff if node.type == "BsdfPrincipled" else abs(a) <= cutoff
+    return abs(a) <= cutoff if node.type == "BsdfGlossy" else a <= cutoff
 
 
 # Nodes that read a per-corner attribute: type -> (prefix of the attribute's name, the

@@ -7,9 +7,6 @@ groups; every node the core evaluates, with its inputs and properties).  On
 top of that, materials translate a few shader nodes the core renders through
 others:
 
-* Metallic BSDF in F82 mode becomes the Principled BSDF at Metallic 1 (the
-  same closure); in Physical Conductor mode its IOR and extinction are fitted
-  to F82 (warned);
 * Subsurface Scattering becomes a Diffuse BSDF of its colour, and the
   Principled's subsurface layer is rendered as diffuse (Cycles' own
   zero-radius limit), warned;
@@ -22,9 +19,7 @@ Colours are linear, in the scene's working colour space.
 """
 from __future__ import annotations
 
-import math
-
-from mcengine.kernels.svm.nodes import INPUTS, Socket
+from mcengine.kernels.svm.nodes import Socket
 from mcengine.scene import Link, Material, ShaderNode
 from mcengine.shaders import GEOMETRY_ATTRIBUTES
 
@@ -37,8 +32,6 @@ DEFAULT_GREY = (0.8, 0.8, 0.8)
 DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
 BLACK = (0.0, 0.0, 0.0)
 _THIN_FILM_CUTOFF = 0.1
-# Inputs of the Principled BSDF and their defaults (the Metallic BSDF is copied into one).
-_PRINCIPLED_DEFAULTS = {socket.name: socket.default for socket in INPUTS["BsdfPrincipled"]}
 
 
 class MaterialTable:
@@ -141,8 +134,6 @@ class _MaterialGraph(GraphReader):
 
     def convert(self, node, groups) -> ShaderNode:
         kind = node.bl_idname
-        if kind == "ShaderNodeBsdfMetallic":
-            return self._metallic(node, groups)
         if kind == "ShaderNodeSubsurfaceScattering":
             self.note(f"{label(node)} (subsurface scattering)", "subsurface",
                       f"{label(node)} rendered as diffuse of its colour")
@@ -176,61 +167,6 @@ class _MaterialGraph(GraphReader):
             self.note(f"{lbl} subsurface weight {fmt(sss) if not isinstance(sss, Link) else '(linked)'}",
                       "subsurface",
                       "subsurface rendered as diffuse of the base colour (Cycles' zero-radius limit)")
-
-    def _metallic(self, node, groups) -> ShaderNode:
-        """Metallic BSDF as the Principled at Metallic 1: the same F82-tint conductor."""
-        inputs = {"Metallic": 1.0}
-        for ident, to, kind in (("Roughness", "Roughness", "float"),
-                                ("Anisotropy", "Anisotropic", "float"),
-                                ("Rotation", "Anisotropic Rotation", "float"),
-                                ("Normal", "Normal", "vector"), ("Tangent", "Tangent", "vector"),
-                                ("Thin Film Thickness", "Thin Film Thickness", "float")):
-            # The Principled's default: an implicit one (the Tangent) stays implicit.
-            value = self._in(node, ident, kind, groups, _PRINCIPLED_DEFAULTS[to])
-            if value is not None:
-                inputs[to] = value
-        if isinstance(inputs.get("Anisotropic"), float):
-            inputs["Anisotropic"] = min(max(inputs["Anisotropic"], 0.0), 1.0)
-        if node.fresnel_type == "F82":
-            inputs["Base Color"] = self._in(node, "Base Color", "color", groups)
-            inputs["Specular Tint"] = self._in(node, "Edge Tint", "color", groups)
-        else:
-            n = _unlinked(node, "IOR")
-            k = _unlinked(node, "Extinction")
-            f0 = [_conductor_fresnel(1.0, a, b) for a, b in zip(n, k)]
-            f82 = [_conductor_fresnel(1.0 / 7.0, a, b) for a, b in zip(n, k)]
-            schlick = [f + (1.0 - f) * (6.0 / 7.0) ** 5 for f in f0]
-            inputs["Base Color"] = tuple(f0)
-            inputs["Specular Tint"] = tuple(min(a / b, 1.0) if b > 0 else 1.0 for a, b in zip(f82, schlick))
-            self.note(f"{label(node)} physical conductor Fresnel", "conductor fresnel",
-                      "fitted to the F82-tint model")
-        props = {"distribution": node.distribution}
-        if props["distribution"] == "ASHIKHMIN_SHIRLEY":
-            self.note(f"{label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley", "GGX used")
-            props["distribution"] = "GGX"
-        self._check(node, "BsdfPrincipled", inputs)
-        return ShaderNode("BsdfPrincipled", inputs, props, name=node.name)
-
-
-def _unlinked(node, ident) -> tuple:
-    sockets = {s.identifier: s for s in node.inputs}
-    return tuple(float(v) for v in sockets[ident].default_value[:3])
-
-
-def _conductor_fresnel(cos_i, n, k) -> float:
-    """Unpolarised reflectance of a conductor of complex IOR n + ik (from air)."""
-    c2 = cos_i * cos_i
-    s2 = 1.0 - c2
-    t0 = n * n - k * k - s2
-    a2b2 = math.sqrt(t0 * t0 + 4.0 * n * n * k * k)
-    a = math.sqrt(max(0.5 * (a2b2 + t0), 0.0))
-    t1 = a2b2 + c2
-    t2 = 2.0 * a * cos_i
-    rs = (t1 - t2) / (t1 + t2)
-    t3 = c2 * a2b2 + s2 * s2
-    t4 = t2 * s2
-    rp = rs * (t3 - t4) / (t3 + t4)
-    return 0.5 * (rs + rp)
 
 
 def linked_node(socket):

@@ -82,7 +82,7 @@ from .state import (
     ST_SELF_HITS,
 )
 from .surface import hit_distance, past_self_hit, surface_point
-from .svm.nodes import K_GLASS, K_GLOSSY, K_PRINCIPLED, K_REFRACTION, K_TRANSPARENT
+from .svm.nodes import K_GLASS, K_GLOSSY, K_METALLIC, K_PRINCIPLED, K_REFRACTION, K_TRANSPARENT
 
 # Integer codes of the classic integrators in the kernels: ``IntegratorInfo.kernel_code``
 # of mcengine.integrators (a test checks that they agree).
@@ -91,7 +91,8 @@ CODE_WHITTED = 2
 CODE_DISTRIBUTION = 3
 # Most Whitted rays one closure node can spawn at a hit (session sizes chunks with it):
 # Principled: coat, metallic, specular mirror rays, glass reflection and refraction, alpha.
-WHITTED_RAYS = {K_PRINCIPLED: 6, K_GLOSSY: 1, K_GLASS: 2, K_REFRACTION: 1, K_TRANSPARENT: 1}
+WHITTED_RAYS = {K_PRINCIPLED: 6, K_GLOSSY: 1, K_METALLIC: 1, K_GLASS: 2, K_REFRACTION: 1,
+                K_TRANSPARENT: 1}
 _K_CHILD = np.uint64(0xA24BAED4963EE407)
 _K_LIGHT = np.uint64(0x9FB21C651E98DF25)
 _NO_MASK = np.uint64(0)          # the independent sampler has no Sobol index to mask

@@ -173,17 +173,25 @@ def test_unsupported_shaders_fall_back_to_grey_diffuse(scene, fake_session):
                         "Toon BSDF rendered as 0.8 grey diffuse"]
 
 
-def test_metallic_node_is_the_principled_conductor(scene, fake_session):
+@pytest.mark.parametrize("fresnel", ["F82", "PHYSICAL_CONDUCTOR"])
+def test_metallic_node_is_copied_with_its_fresnel_type(scene, fake_session, fresnel):
     mat = bpy.data.materials.new("Gold")
     node = replace_surface(mat, "ShaderNodeBsdfMetallic")
-    node.inputs["Base Color"].default_value = (1.0, 0.8, 0.3, 1)
-    node.inputs["Edge Tint"].default_value = (1.0, 0.9, 0.7, 1)
-    node.inputs["Roughness"].default_value = 0.35
+    node.fresnel_type = fresnel
+    # the other type's inputs are unavailable (not found by name), but still copied
+    sockets = {s.identifier: s for s in node.inputs}
+    sockets["Base Color"].default_value = (1.0, 0.8, 0.3, 1)
+    sockets["Edge Tint"].default_value = (1.0, 0.9, 0.7, 1)
+    sockets["IOR"].default_value = (0.18, 0.42, 1.37)
+    sockets["Extinction"].default_value = (3.42, 2.35, 1.77)
+    sockets["Roughness"].default_value = 0.35
     m, warnings = exported(fake_session, mat)
     out = surface(m)
-    assert out.type == "BsdfPrincipled" and out.inputs["Metallic"] == 1.0
+    assert out.type == "BsdfMetallic" and out.props["fresnel_type"] == fresnel
     assert out.inputs["Base Color"] == pytest.approx((1.0, 0.8, 0.3))
-    assert out.inputs["Specular Tint"] == pytest.approx((1.0, 0.9, 0.7))
+    assert out.inputs["Edge Tint"] == pytest.approx((1.0, 0.9, 0.7))
+    assert out.inputs["IOR"] == pytest.approx((0.18, 0.42, 1.37))
+    assert out.inputs["Extinction"] == pytest.approx((3.42, 2.35, 1.77))
     assert out.inputs["Roughness"] == pytest.approx(0.35)
     assert warnings == []
 

@@ -57,6 +57,17 @@ ORACLES = {
     "glossy_beckmann_40": ([("BsdfGlossy", {"Color": (1, 1, 1)}, {"distribution": "BECKMANN"})],
                            0.0, (40.0, 0.0)),
     "glossy_multi": ([("BsdfGlossy", {"Color": (1, 1, 1)}, {})], 0.0, (0.0, 0.0)),
+    "metallic_conductor_45": ([("BsdfMetallic", {"IOR": (0.18, 0.42, 1.37), "Extinction": (3.42, 2.35, 1.77),
+                                                 "Roughness": 0.3}, {"fresnel_type": "PHYSICAL_CONDUCTOR"})],
+                              45.0, (30.0, 180.0)),
+    "metallic_conductor_grazing": ([("BsdfMetallic", {"IOR": (1.37, 0.96, 0.61), "Extinction": (7.6, 6.4, 5.3),
+                                                      "Roughness": 0.15},
+                                     {"fresnel_type": "PHYSICAL_CONDUCTOR", "distribution": "GGX"})],
+                                   75.0, (70.0, 180.0)),
+    "metallic_f82_45": ([("BsdfMetallic", {"Base Color": (1.0, 0.78, 0.34), "Edge Tint": (1.0, 0.8, 0.6),
+                                           "Roughness": 0.3}, {})], 45.0, (30.0, 180.0)),
+    "metallic_beckmann": ([("BsdfMetallic", {"Roughness": 0.4}, {"distribution": "BECKMANN"})],
+                          30.0, (20.0, 180.0)),
     "glass_rough_back_light": ([("BsdfGlass", {"Roughness": 0.4}, {})], 20.0, (150.0, 180.0)),
     "refraction_rough": ([("BsdfRefraction", {"Roughness": 0.3}, {"distribution": "GGX"})],
                          10.0, (160.0, 180.0)),
@@ -74,6 +85,9 @@ ORACLES = {
                                                      "Roughness": 1.0}, {"distribution": "GGX"})],
                                 0.0, None),
     "furnace_glass": ([("BsdfGlass", {"Roughness": 0.5}, {})], 30.0, None),
+    "furnace_metallic_conductor": ([("BsdfMetallic", {"IOR": (0.18, 0.42, 1.37), "Extinction": (3.42, 2.35, 1.77),
+                                                      "Roughness": 1.0}, {"fresnel_type": "PHYSICAL_CONDUCTOR"})],
+                                   30.0, None),
 }
 
 LIGHT_WATTS = 1000.0

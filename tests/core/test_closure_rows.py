@@ -38,6 +38,12 @@ CONSTANT = {
                                  "Shader_001": Link(2, "Holdout")})],
         surface=Link(4, "Shader")),
     "shorthand": Material(base_color=(0.5, 0.5, 0.5), mirror_color=(0.3, 0.3, 0.3)),
+    "metallic conductor over diffuse": Material(nodes=[
+        ShaderNode("BsdfDiffuse", {"Color": (0.2, 0.5, 0.1)}),
+        ShaderNode("BsdfMetallic", {"IOR": (0.18, 0.42, 1.37), "Extinction": (3.42, 2.35, 1.77),
+                                    "Roughness": 0.2}, {"fresnel_type": "PHYSICAL_CONDUCTOR"}),
+        ShaderNode("AddShader", {"Shader": Link(0, "BSDF"), "Shader_001": Link(1, "BSDF")})],
+        surface=Link(2, "Shader")),
 }
 VARYING = {
     "checker": Material(nodes=[ShaderNode("TexChecker", {"Scale": 3.0}),

@@ -12,6 +12,9 @@ n_t / n_i across the interface (below 1 when leaving a denser medium).
 * the F82-tint conductor model (Kutz et al., "Novel aspects of the Adobe Standard
   Material"): Schlick's curve minus ``B cos (1 - cos)^6``, with B chosen from a tint of
   the value at cos = 1/7 (about 82 degrees);
+* the conductor Fresnel of a complex IOR n + ik (``fresnel_conductor``: Born and Wolf's
+  s- and p-polarised reflectances, averaged, as Cycles' ``fresnel_conductor``), and its
+  average through the F82 model fitted at cos = 1 and 1/7 (``fresnel_conductor_Fss``);
 * the generalized Schlick model: the interpolation factor s between F0 and F90, either
   ``(1 - cos)^exponent`` or, for a negative exponent, the exact dielectric Fresnel
   remapped from [F0(eta), 1] to [0, 1] (what every Blender 5.0 node uses).
@@ -142,3 +145,32 @@ def generalized_schlick_s(cos_i, eta, exponent):
     cos_t = math.sqrt(cos_t_sq)
     angle = cos_t if eta < 1.0 else c
     return (1.0 - angle) ** exponent, cos_t, False
+
+
+@device
+def fresnel_conductor(cos_i, n, k):
+    """Unpolarised reflectance of a conductor of complex IOR n + ik seen from a medium of
+    IOR 1, at incidence cosine cos_i (Cycles' fresnel_conductor_polarized, averaged)."""
+    c = min(cos_i, 1.0)
+    n2, k2 = n * n, k * k
+    t1 = n2 - k2 - (1.0 - c * c)
+    t2 = math.sqrt(t1 * t1 + 4.0 * n2 * k2)
+    u_sq = max(0.5 * (t2 + t1), 0.0)
+    v_sq = max(0.5 * (t2 - t1), 0.0)
+    u, v = math.sqrt(u_sq), math.sqrt(v_sq)
+    den = (c + u) * (c + u) + v_sq
+    rs = ((c - u) * (c - u) + v_sq) / den if den != 0.0 else 0.0
+    t3 = (n2 - k2) * c
+    t4 = 2.0 * n * k * c
+    den = (t3 + u) * (t3 + u) + (t4 + v) * (t4 + v)
+    rp = ((t3 - u) * (t3 - u) + (t4 - v) * (t4 - v)) / den if den != 0.0 else 0.0
+    return 0.5 * (rs + rp)
+
+
+@device
+def fresnel_conductor_Fss(n, k):
+    """Average single-scattering reflectance of a conductor, as Cycles estimates it: the F82
+    model through its values at cos = 1 and 1/7, averaged exactly (clamped to [0, 1])."""
+    f0 = fresnel_conductor(1.0, n, k)
+    b = f82_B(f0, fresnel_conductor(1.0 / 7.0, n, k))
+    return min(max(fresnel_f82_Fss(f0, b), 0.0), 1.0)

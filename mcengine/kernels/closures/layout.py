@@ -34,8 +34,9 @@ CL_AY = 12               # microfacet alpha along the bitangent
 CL_ETA = 13              # relative index of refraction (inside / outside; 1/IOR on back faces)
 CL_DIST = 14             # MD_* distribution
 CL_FRESNEL = 15          # FR_* Fresnel model
-CL_F0 = 16               # 3: reflectance at normal incidence (Schlick, F82)
-CL_F90 = 19              # 3: generalized Schlick: reflectance at grazing incidence; F82: B term
+CL_F0 = 16               # 3: reflectance at normal incidence (Schlick, F82); conductor: n
+CL_F90 = 19              # 3: generalized Schlick: reflectance at grazing incidence; F82: B term;
+                         #    conductor: k
 CL_EXPONENT = 22         # generalized Schlick exponent (< 0: remap the real Fresnel curve)
 CL_RTINT = 23            # 3: reflection tint
 CL_TTINT = 26            # 3: transmission tint
@@ -66,6 +67,7 @@ FR_NONE = 0              # reflectance 1 (the weight carries the colour), no TIR
 FR_DIELECTRIC = 1        # exact unpolarised dielectric Fresnel with CL_ETA
 FR_SCHLICK = 2           # generalized Schlick: mix(F0, F90, s) x tints
 FR_F82 = 3               # F82-tint conductor: Schlick(F0) - B cos (1 - cos)^6
+FR_CONDUCTOR = 4         # conductor of complex IOR: n in CL_F0, k in CL_F90 (per channel)
 
 # -- microfacet distributions ------------------------------------------------------------------
 MD_GGX = 0

@@ -41,6 +41,8 @@ from ...jit import device, function
 from .fresnel import (
     F0_from_ior,
     f82_tint_B,
+    fresnel_conductor,
+    fresnel_conductor_Fss,
     fresnel_dielectric,
     fresnel_dielectric_Fss,
     fresnel_f82,
@@ -65,6 +67,7 @@ from .layout import (
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
+    FR_CONDUCTOR,
     FR_DIELECTRIC,
     FR_F82,
     FR_SCHLICK,
@@ -336,7 +339,8 @@ def microfacet_fresnel(cl, k, cos_hi):
     * FR_SCHLICK: F = mix(F0, F90, s) with s from ``generalized_schlick_s`` (CL_EXPONENT),
       R = F x CL_RTINT, T = (1 - F) x CL_TTINT; with exponent >= 0 total internal
       reflection gives R = CL_RTINT, T = 0;
-    * FR_F82: R = F82(F0 = CL_F0, B = CL_F90), T = 0.
+    * FR_F82: R = F82(F0 = CL_F0, B = CL_F90), T = 0;
+    * FR_CONDUCTOR: R = the conductor Fresnel of n = CL_F0, k = CL_F90, T = 0.
     """
     ctype = int(cl[k, CL_TYPE])
     has_r = 1.0 if ctype != CT_MICROFACET_REFRACTION else 0.0
@@ -370,10 +374,13 @@ def microfacet_fresnel(cl, k, cos_hi):
         tr = (1.0 - fr) * cl[k, CL_TTINT]
         tg = (1.0 - fg) * cl[k, CL_TTINT + 1]
         tb = (1.0 - fb) * cl[k, CL_TTINT + 2]
-    elif model == FR_F82:
+    elif model == FR_F82 or model == FR_CONDUCTOR:
         rr = rg = rb = 0.0
         for c in range(3):
-            v = fresnel_f82(cos_hi, cl[k, CL_F0 + c], cl[k, CL_F90 + c])
+            if model == FR_F82:
+                v = fresnel_f82(cos_hi, cl[k, CL_F0 + c], cl[k, CL_F90 + c])
+            else:
+                v = fresnel_conductor(cos_hi, cl[k, CL_F0 + c], cl[k, CL_F90 + c])
             if c == 0:
                 rr = v
             elif c == 1:
@@ -577,7 +584,8 @@ def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     GGX_GEN_SCHLICK_S at z = 1 / (0.2 exponent + 1)), FR_F82 (mix(F0, 1, s), s from
     GGX_GEN_SCHLICK_S at z = 0.5, B ignored) and FR_DIELECTRIC with eta > 1
     (mix(F0(eta), 1, s) from GGX_GEN_SCHLICK_IOR_S), all read at r = (ax ay)^(1/4),
-    whatever the distribution.  Transmission is always the smooth (1 - F) x tint.
+    whatever the distribution.  Transmission is always the smooth (1 - F) x tint (and the
+    conductor's reflection the smooth Fresnel: Cycles has no table for it).
     """
     rr, rg, rb, tr, tg, tb, _ = microfacet_fresnel(cl, k, cos_no)
     if not with_reflection:
@@ -750,6 +758,22 @@ def microfacet_setup_fresnel_f82_tint(cl, k, cos_no, tint_r, tint_g, tint_b, pre
                                    fresnel_f82_Fss(cl[k, CL_F0], cl[k, CL_F90]),
                                    fresnel_f82_Fss(cl[k, CL_F0 + 1], cl[k, CL_F90 + 1]),
                                    fresnel_f82_Fss(cl[k, CL_F0 + 2], cl[k, CL_F90 + 2]))
+
+
+@device
+def microfacet_setup_fresnel_conductor(cl, k, cos_no, preserve_energy):
+    """FR_CONDUCTOR (Cycles' bsdf_microfacet_setup_fresnel_conductor).
+
+    Expects n in CL_F0 and k in CL_F90; CL_SW *= mean albedo estimate, and with
+    ``preserve_energy`` compensates with Fss = fresnel_conductor_Fss(n, k).
+    """
+    cl[k, CL_FRESNEL] = FR_CONDUCTOR
+    microfacet_setup_sample_weight(cl, k, cos_no)
+    if preserve_energy:
+        microfacet_preserve_energy(cl, k, cos_no,
+                                   fresnel_conductor_Fss(cl[k, CL_F0], cl[k, CL_F90]),
+                                   fresnel_conductor_Fss(cl[k, CL_F0 + 1], cl[k, CL_F90 + 1]),
+                                   fresnel_conductor_Fss(cl[k, CL_F0 + 2], cl[k, CL_F90 + 2]))
 
 
 @device

@@ -66,6 +66,7 @@ from .nodes import (
     DIST_BECKMANN,
     DIST_MULTI_GGX,
     E_STRENGTH,
+    FRESNEL_PHYSICAL_CONDUCTOR,
     G_ANISOTROPY,
     G_DISTRIBUTION,
     G_NORMAL,
@@ -82,11 +83,23 @@ from .nodes import (
     K_GLASS,
     K_GLOSSY,
     K_HOLDOUT,
+    K_METALLIC,
     K_PRINCIPLED,
     K_REFRACTION,
     K_SHEEN,
     K_TRANSLUCENT,
     K_TRANSPARENT,
+    M_ANISOTROPY,
+    M_BASE_COLOR,
+    M_DISTRIBUTION,
+    M_EDGE_TINT,
+    M_EXTINCTION,
+    M_FRESNEL,
+    M_IOR,
+    M_NORMAL,
+    M_ROTATION,
+    M_ROUGHNESS,
+    M_TANGENT,
     P_ALPHA,
     P_ANISOTROPIC,
     P_ANISOTROPIC_ROTATION,
@@ -246,6 +259,11 @@ def microfacet_setup_fresnel_f82_tint(cl, k, cos_no, tr, tg, tb, preserve_energy
 
 
 @function
+def microfacet_setup_fresnel_conductor(cl, k, cos_no, preserve_energy):
+    mf.microfacet_setup_fresnel_conductor(cl, k, cos_no, preserve_energy)
+
+
+@function
 def microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy):
     mf.microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy)
 
@@ -341,6 +359,9 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
     elif kind == K_GLOSSY:
         if sd.reflective_caustics:
             n = glossy(regs, b, cl, n, sd, cr, cg, cb)
+    elif kind == K_METALLIC:
+        if sd.reflective_caustics:
+            n = metallic(regs, b, w, cl, n, sd)
     elif kind == K_GLASS:
         n = glass(regs, b, w, cl, n, sd)
     elif kind == K_REFRACTION:
@@ -430,6 +451,47 @@ def glossy(regs, b, cl, n, sd, cr, cg, cb):
     if dist == DIST_MULTI_GGX:
         microfacet_setup_fresnel_constant(cl, k, cos_no, max(regs[b + COLOR_IN], 0.0),
                                           max(regs[b + COLOR_IN + 1], 0.0), max(regs[b + COLOR_IN + 2], 0.0))
+    return n
+
+
+@function
+def metallic(regs, b, w, cl, n, sd):
+    """Metallic BSDF: microfacet reflection weighted by the mix weight alone, its colour in
+    the Fresnel: F82 tint of the clamped Base Color and Edge Tint, or the conductor Fresnel of
+    IOR + i Extinction (both clamped >= 0); anisotropy stretches alpha by
+    sqrt(1 - 0.9 anisotropy) as the Principled's; Multiscatter GGX compensates energy."""
+    k, n = alloc(cl, n, w, w, w, sd)
+    if k < 0:
+        return n
+    inx, iny, inz = input_normal(regs, b + M_NORMAL, sd)
+    nx, ny, nz = ensure_valid_reflection(sd, inx, iny, inz)
+    a = sat(regs[b + M_ROUGHNESS]) ** 2
+    aniso = sat(regs[b + M_ANISOTROPY])
+    tx, ty, tz = regs[b + M_TANGENT], regs[b + M_TANGENT + 1], regs[b + M_TANGENT + 2]
+    ax = ay = a
+    if aniso > 0.0 and (tx != 0.0 or ty != 0.0 or tz != 0.0):
+        aspect = math.sqrt(1.0 - 0.9 * aniso)
+        ax, ay = a / aspect, a * aspect
+        rot = regs[b + M_ROTATION]
+        if rot != 0.0:
+            # about the input normal, as Cycles (the Glossy BSDF turns about the valid one)
+            tx, ty, tz = rotate_around_axis(tx, ty, tz, inx, iny, inz, rot * 2.0 * math.pi)
+    else:
+        tx = ty = tz = 0.0
+    dist = regs[b + M_DISTRIBUTION]
+    cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, 1.0, nx, ny, nz, tx, ty, tz, sd)
+    multiscatter = dist == DIST_MULTI_GGX
+    if regs[b + M_FRESNEL] == FRESNEL_PHYSICAL_CONDUCTOR:
+        for c in range(3):
+            cl[k, CL_F0 + c] = max(regs[b + M_IOR + c], 0.0)
+            cl[k, CL_F90 + c] = max(regs[b + M_EXTINCTION + c], 0.0)
+        microfacet_setup_fresnel_conductor(cl, k, cos_no, multiscatter)
+    else:
+        for c in range(3):
+            cl[k, CL_F0 + c] = sat(regs[b + M_BASE_COLOR + c])
+        microfacet_setup_fresnel_f82_tint(cl, k, cos_no, sat(regs[b + M_EDGE_TINT]),
+                                          sat(regs[b + M_EDGE_TINT + 1]), sat(regs[b + M_EDGE_TINT + 2]),
+                                          multiscatter)
     return n
 
 

@@ -296,7 +296,8 @@ def attribute_node(regs, b, c, sd, tex):
 @device
 def geometry(regs, c, sd, tex):
     """Geometry: Position, Normal, Tangent (radial about object Z), True Normal, Incoming,
-    Parametric, Backfacing, Pointiness (not yet: 0.5) and Random Per Island (not yet: 0)."""
+    Parametric, Backfacing; Pointiness and Random Per Island are mesh attributes, which the
+    compiler reads with an Attribute node where they are linked (0.5 and 0 stand here)."""
     _store3(regs, c, sd.px, sd.py, sd.pz)
     _store3(regs, c + 3, sd.nx, sd.ny, sd.nz)
     tx, ty, tz = radial_tangent(sd, tex, AXIS_Z)

@@ -181,8 +181,15 @@ DIRECTION_TYPES = {"RADIAL": DIRECTION_RADIAL, "UV_MAP": DIRECTION_UV_MAP}
 AXIS_X, AXIS_Y, AXIS_Z = 0, 1, 2
 AXES = {"X": AXIS_X, "Y": AXIS_Y, "Z": AXIS_Z}
 
+# Metallic BSDF: the F82-tint model of Base Color and Edge Tint, or the conductor Fresnel of
+# the complex IOR (IOR + i Extinction).
+FRESNEL_F82 = 0
+FRESNEL_PHYSICAL_CONDUCTOR = 1
+FRESNEL_TYPES = {"F82": FRESNEL_F82, "PHYSICAL_CONDUCTOR": FRESNEL_PHYSICAL_CONDUCTOR}
+
 ENUMS = {
     "distribution": DISTRIBUTIONS,
+    "fresnel_type": FRESNEL_TYPES,
     "operation": OPERATIONS,
     "interpolation_type": MAP_RANGE_INTERPOLATIONS,
     "data_type": DATA_TYPES,
@@ -290,6 +297,13 @@ CLOSURES = {
     "BsdfTranslucent": NodeSpec(6, (_c("Color", GREY), _v("Normal")), _BSDF, False),
     "BsdfTransparent": NodeSpec(7, (_c("Color", WHITE),), _BSDF, False),
     "BsdfSheen": NodeSpec(8, (_c("Color", GREY), _f("Roughness", 0.5), _v("Normal")), _BSDF, False),
+    "BsdfMetallic": NodeSpec(12, (_c("Base Color", (0.617, 0.577, 0.540)),
+                                  _c("Edge Tint", (0.695, 0.726, 0.770)),
+                                  _v("IOR", (2.757, 2.513, 2.231)), _v("Extinction", (3.867, 3.404, 3.009)),
+                                  _f("Roughness", 0.5), _f("Anisotropy", 0.0), _f("Rotation", 0.0),
+                                  _v("Normal"), _v("Tangent", TANGENT), _f("Thin Film Thickness", 0.0),
+                                  _f("Thin Film IOR", 1.33), _p("distribution", DIST_MULTI_GGX),
+                                  _p("fresnel_type", FRESNEL_F82)), _BSDF, False),
     "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
                          (Socket("Emission", SHADER, None),), False),
     "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
@@ -548,6 +562,18 @@ R_IOR = OFFSETS["BsdfRefraction"]["IOR"]
 R_NORMAL = OFFSETS["BsdfRefraction"]["Normal"]
 R_DISTRIBUTION = OFFSETS["BsdfRefraction"]["prop:distribution"]
 TL_NORMAL = OFFSETS["BsdfTranslucent"]["Normal"]
+_M = OFFSETS["BsdfMetallic"]
+M_BASE_COLOR = _M["Base Color"]
+M_EDGE_TINT = _M["Edge Tint"]
+M_IOR = _M["IOR"]
+M_EXTINCTION = _M["Extinction"]
+M_ROUGHNESS = _M["Roughness"]
+M_ANISOTROPY = _M["Anisotropy"]
+M_ROTATION = _M["Rotation"]
+M_NORMAL = _M["Normal"]
+M_TANGENT = _M["Tangent"]
+M_DISTRIBUTION = _M["prop:distribution"]
+M_FRESNEL = _M["prop:fresnel_type"]
 S_ROUGHNESS = OFFSETS["BsdfSheen"]["Roughness"]
 S_NORMAL = OFFSETS["BsdfSheen"]["Normal"]
 E_STRENGTH = OFFSETS["Emission"]["Strength"]
@@ -561,6 +587,7 @@ K_REFRACTION = KIND["BsdfRefraction"]
 K_TRANSLUCENT = KIND["BsdfTranslucent"]
 K_TRANSPARENT = KIND["BsdfTransparent"]
 K_SHEEN = KIND["BsdfSheen"]
+K_METALLIC = KIND["BsdfMetallic"]
 K_EMISSION = KIND["Emission"]
 K_HOLDOUT = KIND["Holdout"]
 K_BACKGROUND = KIND["Background"]

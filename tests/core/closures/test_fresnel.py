@@ -11,6 +11,8 @@ from mcengine.kernels.closures.fresnel import (
     F0_from_ior,
     f82_B,
     f82_tint_B,
+    fresnel_conductor,
+    fresnel_conductor_Fss,
     fresnel_dielectric,
     fresnel_dielectric_Fss,
     fresnel_f82,
@@ -115,3 +117,40 @@ def test_generalized_schlick():
     assert not tir and s == pytest.approx((1 - cos_t) ** 5)
     assert generalized_schlick_s(0.1, 1 / 1.5, 5.0) == (1.0, 0.0, True)
     assert generalized_schlick_s(0.1, 1 / 1.5, -1.0)[0] == 1.0          # remapped: F = 1 -> s = 1
+
+
+def _conductor_textbook(c: float, n: float, k: float) -> float:
+    """Unpolarised reflectance of a conductor from complex Snell's law and the s/p amplitudes
+    (Python complex arithmetic, an independent form)."""
+    eta = complex(n, k)
+    cos_t = np.sqrt(1.0 - (1.0 - c * c) / eta ** 2)
+    rs = (c - eta * cos_t) / (c + eta * cos_t)
+    rp = (eta * c - cos_t) / (eta * c + cos_t)
+    return 0.5 * (abs(rs) ** 2 + abs(rp) ** 2)
+
+
+# Complex IORs at R, G, B: gold and copper (the Metallic BSDF's presets' kind), aluminium, and
+# a dielectric (k = 0).
+CONDUCTORS = [(0.18, 3.42), (0.42, 2.35), (1.37, 1.77), (0.27, 3.61), (1.22, 7.0), (1.5, 0.0)]
+
+
+@pytest.mark.parametrize("n, k", CONDUCTORS)
+def test_conductor_fresnel(n, k):
+    for c in [1.0, 0.999, 0.7, 0.3, 1 / 7, 0.01, 1e-7]:
+        assert fresnel_conductor(c, n, k) == pytest.approx(_conductor_textbook(c, n, k), rel=1e-9, abs=1e-12)
+    assert fresnel_conductor(1.0, n, k) == pytest.approx(((n - 1) ** 2 + k * k) / ((n + 1) ** 2 + k * k))
+    assert fresnel_conductor(0.0, n, k) == pytest.approx(1.0)
+    if k == 0.0:
+        for c in [1.0, 0.5, 0.1]:
+            assert fresnel_conductor(c, n, 0.0) == pytest.approx(fresnel_dielectric(c, n)[0], abs=1e-12)
+
+
+@pytest.mark.parametrize("n, k", CONDUCTORS)
+def test_conductor_Fss_is_the_f82_fit_of_the_average(n, k):
+    """Cycles' estimate: the F82 model through F(1) and F(1/7), averaged exactly; it stays
+    close to the true average 2 int cos F (measured: 0.0009 to 0.0030 off for the metals,
+    0.009 for n 1.37 + 1.77i, 0.0101 for the dielectric)."""
+    f0, f82 = fresnel_conductor(1.0, n, k), fresnel_conductor(1 / 7, n, k)
+    assert fresnel_conductor_Fss(n, k) == pytest.approx(fresnel_f82_Fss(f0, f82_B(f0, f82)), abs=1e-12)
+    exact = quad(lambda c: 2 * c * fresnel_conductor(c, n, k), 0, 1)[0]
+    assert fresnel_conductor_Fss(n, k) == pytest.approx(exact, abs=0.012)

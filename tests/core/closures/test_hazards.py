@@ -17,6 +17,7 @@ from mcengine.kernels.closures.layout import (
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_TRANSLUCENT,
+    FR_CONDUCTOR,
     FR_DIELECTRIC,
     FR_F82,
     FR_NONE,
@@ -38,6 +39,7 @@ cosines = st.one_of(st.sampled_from([1e-7, 1e-6, 1e-4, 0.01, 0.5, 1.0 - 1e-12, 1
 uniforms = st.one_of(st.sampled_from([0.0, 0.5, ONE_MINUS, 1e-300]), st.floats(0.0, ONE_MINUS))
 kinds = st.sampled_from([
     (CT_MICROFACET, FR_NONE), (CT_MICROFACET, FR_F82), (CT_MICROFACET, FR_SCHLICK), (CT_MICROFACET, FR_DIELECTRIC),
+    (CT_MICROFACET, FR_CONDUCTOR),
     (CT_MICROFACET_REFRACTION, FR_NONE), (CT_MICROFACET_GLASS, FR_DIELECTRIC), (CT_MICROFACET_GLASS, FR_SCHLICK),
 ])
 WHITE = (FR_NONE, FR_DIELECTRIC)
@@ -78,8 +80,10 @@ def _check(cl, wo, u, white):
 def test_microfacet_hazards(kind, dist, r, r2, eta, cos_t, phi, u1, u2, u3, f0, b, exponent):
     ctype, fresnel = kind
     cl = microfacet_row(ctype=ctype, dist=dist, alpha=r * r, alpha_y=r2 * r2 if ctype == CT_MICROFACET else None,
-                        eta=eta, fresnel=fresnel, f0=(f0, f0, f0), f90=(1.0, 1.0, 1.0) if fresnel != FR_F82 else
-                        (b, b, b), exponent=exponent, energy=1.0)
+                        eta=eta, fresnel=fresnel, f0=(f0, f0, f0) if fresnel != FR_CONDUCTOR else (eta, eta, eta),
+                        f90=(b, b, b) if fresnel == FR_F82 else ((abs(b) * 5,) * 3 if fresnel == FR_CONDUCTOR
+                                                                 else (1.0, 1.0, 1.0)),
+                        exponent=exponent, energy=1.0)
     wo = _view(cos_t, phi)
     rng = np.random.default_rng(1)
     u = np.concatenate([[[u1, u2, u3]], rng.random((64, 3))])

@@ -18,6 +18,7 @@ from mcengine.kernels.closures.layout import (
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
+    FR_CONDUCTOR,
     FR_DIELECTRIC,
     FR_F82,
     FR_NONE,
@@ -43,6 +44,8 @@ ROWS = {
     "ggx-aniso": dict(alpha=0.05, alpha_y=0.4),
     "beckmann-aniso": dict(alpha=0.4, alpha_y=0.05, dist=MD_BECKMANN),
     "ggx-f82": dict(alpha=0.3, fresnel=FR_F82, f0=(0.9, 0.6, 0.3), f90=(0.2, 0.1, -0.1)),
+    # gold's complex IOR: n in the F0 columns, k in the F90 ones
+    "ggx-conductor": dict(alpha=0.3, fresnel=FR_CONDUCTOR, f0=(0.18, 0.42, 1.37), f90=(3.42, 2.35, 1.77)),
     "ggx-schlick": dict(alpha=0.3, fresnel=FR_SCHLICK, f0=(0.1, 0.2, 0.05), f90=(1, 1, 1), eta=1.45,
                         rtint=(1, 0.5, 0.8)),
     "ggx-schlick-exp5": dict(alpha=0.3, fresnel=FR_SCHLICK, f0=(0.1, 0.2, 0.05), f90=(1, 0.9, 1), exponent=5.0),

@@ -391,9 +391,8 @@ class _Compiler:
             outputs[socket.name] = Value(socket.type, reg=k)
             k += SIZE[socket.type]
         if node.type == "NewGeometry":
-            index = next((k for k, n in enumerate(self.nodes) if n is node), -1)
             for name, attribute in GEOMETRY_ATTRIBUTES.items():
-                if (index, name) in self.linked:
+                if self.is_linked(node, name):
                     read = ShaderNode("Attribute", props={"attribute_name": attribute})
                     outputs[name] = self.evaluate(read, VALUE_NODES["Attribute"])["Fac"]
         return outputs
@@ -418,10 +417,15 @@ class _Compiler:
         names = [s.name for s in spec.inputs]
         slot = self.images.get(str(node.props.get("image", "")), -1)
         values[names.index("prop:image")] = Value(FLOAT, (float(slot),))
-        index = next(k for k, n in enumerate(self.nodes) if n is node)
-        linked = 1.0 if (index, "Alpha") in self.linked else 0.0
+        linked = 1.0 if self.is_linked(node, "Alpha") else 0.0
         values[names.index("prop:alpha_linked")] = Value(FLOAT, (linked,))
         return values
+
+    def is_linked(self, node, output: str) -> bool:
+        """Whether something is linked to ``output`` of ``node`` (False for the nodes the
+        compiler inserts itself, which are not in the graph)."""
+        index = next((k for k, n in enumerate(self.nodes) if n is node), -1)
+        return (index, output) in self.linked
 
     def fold(self, spec, values) -> dict:
         """Evaluate a pure node with constant inputs now, with the kernels' own code."""

@@ -52,10 +52,11 @@ class MaterialTable:
         """Names of the attributes the materials converted so far read: those of Attribute
         nodes, and those derived from the mesh that a Geometry node's output reads
         (``GEOMETRY_ATTRIBUTES``)."""
-        names = {str(node.props.get("attribute_name", "")) for m in self.materials
-                 for node in m.nodes if node.type == "Attribute"}
+        names = set()
         for m in self.materials:
             for node in m.nodes:
+                if node.type == "Attribute":
+                    names.add(str(node.props.get("attribute_name", "")))
                 for value in node.inputs.values():
                     if (isinstance(value, Link) and value.socket in GEOMETRY_ATTRIBUTES
                             and m.nodes[value.node].type == "NewGeometry"):

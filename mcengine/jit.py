@@ -33,6 +33,7 @@
   kernels never allocate or return arrays; the caller's references keep
   every array they touch alive.
 """
+import copy
 import hashlib
 import os
 import shutil
@@ -96,6 +97,68 @@ def _cached(decorator):
             config.CACHE_DIR = previous
     return apply
 
+
+def _speed_up_inlining() -> None:
+    """Two changes to how numba inlines ``inline="always"`` functions: the compiled code is
+    the same, a cold compile of the path tracer took 529 s instead of 898 s
+    (``benchmarks/compile_times.py``), of every integrator 724 s instead of 1143 s.  Left
+    alone if this numba lays inlining out otherwise.
+
+    * numba copies the callee's IR before splicing it in with one ``copy.deepcopy`` per
+      block, and each block refers to the function's scope, which holds every variable:
+      so every block copied the whole variable table again, work that grows as blocks times
+      variables in the large inlined functions.  The blocks of one IR now share one copy
+      of their scope, as they shared the scope they were copied from.
+    * for every call site numba also prepared the callee's IR from its bytecode again,
+      inlining the callee's own callees again, and so on down the call tree.  The IR it
+      prepares is only ever copied, so it is kept and handed out again, under a fresh
+      function identity, from which numba names the inlined variables as a fresh run would.
+    """
+    try:
+        from numba.core import bytecode, ir
+        from numba.core import inline_closurecall as inlining
+    except ImportError:         # pragma: no cover - another numba layout
+        return
+    worker = getattr(inlining, "InlineWorker", None)
+    original = getattr(worker, "run_untyped_passes", None)
+    if original is None or getattr(inlining, "copy", None) is not copy:
+        return
+
+    class BlockCopier:
+        """``copy`` as ``inline_closurecall`` sees it: blocks of one scope share its copy."""
+
+        def __init__(self):
+            self.last = None      # (scope, its copy, their numbers of variables)
+
+        def deepcopy(self, x, memo=None):
+            if memo is not None or not isinstance(x, ir.Block):
+                return copy.deepcopy(x, memo)
+            scope, last = x.scope, self.last
+            if last is None or last[0] is not scope or \
+                    (len(scope.localvars._con), len(last[1].localvars._con)) != last[2]:
+                shared = copy.deepcopy(scope)
+                last = self.last = (scope, shared,
+                                    (len(scope.localvars._con), len(shared.localvars._con)))
+            return copy.deepcopy(x, {id(scope): last[1]})
+
+    prepared = {}
+
+    def run_untyped_passes(self, func, enable_ssa=False):
+        key = (func, enable_ssa)
+        if key not in prepared:
+            prepared[key] = original(self, func, enable_ssa)
+        else:
+            self.flags.enable_ssa = enable_ssa     # as the pipeline run sets it
+        func_ir = prepared[key].copy()
+        func_ir.func_id = bytecode.FunctionIdentity.from_function(func)
+        return func_ir
+
+    run_untyped_passes.__wrapped__ = original
+    inlining.copy = BlockCopier()
+    worker.run_untyped_passes = run_untyped_passes
+
+
+_speed_up_inlining()
 
 device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=False))
 # Host-side builders that allocate their results (acceleration structures), run once per render.

@@ -10,13 +10,18 @@ installed sources is not ready, so that the first F12 finds them compiled::
 It renders one sample of one pixel of a tiny scene with each integrator, the
 default one first (every shader node and closure is compiled with the shader
 evaluator, whatever the scene uses), then marks the cache ready
-(``jit.cache_is_ready``).  Compiling every integrator here matters beyond the
+(``jit.cache_is_ready``).  numba compiles on one core: once the shader evaluator,
+which every integrator calls, is in the cache, a second process
+(``python -m mcengine.warmup --only NAME...``) compiles the other integrators while
+this one compiles the default one.  Compiling every integrator here matters beyond the
 wait: numba compiling inside a Blender process where Cycles has rendered can
 crash that process (seen with bpy 5.0.1: a segfault in the next render), so a
 user's first Whitted render after a Cycles one must find its kernels compiled.
 """
 from __future__ import annotations
 
+import signal
+import subprocess
 import sys
 import time
 
@@ -53,18 +58,46 @@ def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
         integrator=Integrator(name=integrator, samples=1))
 
 
-def compile_kernels() -> float:
-    """Compile (or load) every integrator's kernels, the default one first; seconds taken."""
+def _compile(names) -> None:
     from .session import RenderSession
-    start = time.perf_counter()
-    for name in sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT):
+    for name in names:
         RenderSession(warm_up_scene(name), threads=1).run()
         _marker(name).touch()
+
+
+def compile_kernels(processes: int = 2) -> float:
+    """Compile (or load) every integrator's kernels, the default one first; seconds taken.
+
+    With two ``processes``, the others are compiled by a second process once this one has
+    put the shader evaluator into the cache."""
+    from .packing import pack_scene
+    start = time.perf_counter()
+    names = sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT)
+    helper = None
+    try:
+        if processes > 1 and len(names) > 1:
+            pack_scene(warm_up_scene())        # compiles the shader evaluator
+            names, others = names[:1], names[1:]
+            helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *others],
+                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+        _compile(names)
+        if helper is not None and helper.wait() != 0:
+            raise RuntimeError(f"compiling the kernels of {', '.join(others)} failed "
+                               f"(exit status {helper.returncode})")
+    finally:
+        if helper is not None and helper.poll() is None:     # this process was stopped
+            helper.terminate()
     jit.mark_cache_ready()
     return time.perf_counter() - start
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    # The add-on ends the background compile with SIGTERM: end the helper process too.
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    if args[:1] == ["--only"]:
+        _compile(args[1:])
+        return 0
     if jit.cache_is_ready():
         print("mcengine: kernels already compiled")
         return 0

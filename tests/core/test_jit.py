@@ -1,0 +1,104 @@
+"""mcengine.jit's changes to numba's inlining: faster compiles, the same programs."""
+from __future__ import annotations
+
+import copy
+import re
+
+import numpy as np
+from numba import njit
+from numba.core import compiler, ir
+from numba.core import inline_closurecall as inlining
+from numba.core.registry import cpu_target
+
+import mcengine.jit  # noqa: F401  (installs the changes)
+
+
+@njit(inline="always")
+def _scaled(x, k):
+    y = x * k
+    if y > 1.0:
+        y = 1.0 + 0.5 * (y - 1.0)
+    return y
+
+
+@njit(inline="always")
+def _twice(x, k):
+    a = _scaled(x, k)       # the same callee twice in one caller, and again one level up
+    b = _scaled(a, k)
+    return a + b
+
+
+@njit
+def _caller(xs, k):
+    out = np.empty_like(xs)
+    for i in range(xs.shape[0]):
+        out[i] = _twice(xs[i], k) - _scaled(xs[i], 2.0 * k)
+    return out
+
+
+def test_inlined_calls_compute_what_python_does():
+    xs = np.linspace(-2.0, 3.0, 41)
+    expected = np.array([_twice.py_func(x, 0.7) - _scaled.py_func(x, 1.4) for x in xs])
+    np.testing.assert_array_equal(_caller(xs, 0.7), expected)
+
+
+def test_block_copies_share_one_copy_of_their_scope():
+    func_ir = compiler.run_frontend(_scaled.py_func)      # an if: several blocks
+    blocks = list(func_ir.blocks.values())
+    assert len(blocks) > 1 and all(b.scope is blocks[0].scope for b in blocks)
+    copies = [inlining.copy.deepcopy(b) for b in blocks]
+    scope = copies[0].scope
+    assert scope is not blocks[0].scope
+    assert all(c.scope is scope for c in copies)
+    assert scope.localvars._con.keys() == blocks[0].scope.localvars._con.keys()
+    # the copy is the callee's own: renaming its variables leaves the original alone
+    before = len(blocks[0].scope.localvars._con)
+    scope.redefine("$inlined_name", ir.Loc("test", 0))
+    assert len(blocks[0].scope.localvars._con) == before
+    again = inlining.copy.deepcopy(blocks[0])       # after a change, a new copy
+    assert again.scope is not scope and "$inlined_name" not in again.scope.localvars._con
+
+
+def test_prepared_inlinee_is_handed_out_fresh():
+    worker = inlining.InlineWorker(cpu_target.typing_context, cpu_target.target_context,
+                                   {}, object(), compiler.Flags())
+    first = worker.run_untyped_passes(_twice.py_func)
+    second = worker.run_untyped_passes(_twice.py_func)
+    assert first.func_id.unique_name != second.func_id.unique_name
+    assert first.blocks is not second.blocks
+    assert all(first.blocks[k] is not second.blocks[k] for k in first.blocks)
+    assert first.blocks.keys() == second.blocks.keys()
+
+
+def _fresh_caller():
+    """New dispatchers of the functions above (numba compiles each once)."""
+    scaled = njit(inline="always")(_scaled.py_func)
+
+    @njit(inline="always")
+    def twice(x, k):
+        a = scaled(x, k)
+        b = scaled(a, k)
+        return a + b
+
+    @njit
+    def caller(xs, k):
+        out = np.empty_like(xs)
+        for i in range(xs.shape[0]):
+            out[i] = twice(xs[i], k) - scaled(xs[i], 2.0 * k)
+        return out
+    return caller
+
+
+def _machine_code(caller) -> str:
+    caller(np.linspace(-2.0, 3.0, 5), 0.7)
+    (asm,) = caller.inspect_asm().values()
+    # mangled names carry a per-process counter of compiled functions ("B3v11")
+    return re.sub(r"B\d+v\d+B", "B_v_B", asm)
+
+
+def test_the_changes_leave_the_machine_code_as_it_was(monkeypatch):
+    changed = _machine_code(_fresh_caller())
+    monkeypatch.setattr(inlining, "copy", copy)
+    monkeypatch.setattr(inlining.InlineWorker, "run_untyped_passes",
+                        inlining.InlineWorker.run_untyped_passes.__wrapped__)
+    assert _machine_code(_fresh_caller()) == changed

@@ -23,23 +23,15 @@ def _scaled(x, k):
 
 @njit(inline="always")
 def _twice(x, k):
-    a = _scaled(x, k)       # the same callee twice in one caller, and again one level up
+    a = _scaled(x, k)
     b = _scaled(a, k)
     return a + b
-
-
-@njit
-def _caller(xs, k):
-    out = np.empty_like(xs)
-    for i in range(xs.shape[0]):
-        out[i] = _twice(xs[i], k) - _scaled(xs[i], 2.0 * k)
-    return out
 
 
 def test_inlined_calls_compute_what_python_does():
     xs = np.linspace(-2.0, 3.0, 41)
     expected = np.array([_twice.py_func(x, 0.7) - _scaled.py_func(x, 1.4) for x in xs])
-    np.testing.assert_array_equal(_caller(xs, 0.7), expected)
+    np.testing.assert_array_equal(_fresh_caller()(xs, 0.7), expected)
 
 
 def test_block_copies_share_one_copy_of_their_scope():
@@ -71,7 +63,8 @@ def test_prepared_inlinee_is_handed_out_fresh():
 
 
 def _fresh_caller():
-    """New dispatchers of the functions above (numba compiles each once)."""
+    """``_twice(x, k) - _scaled(x, 2k)`` over an array, in new dispatchers (numba compiles
+    each once): one callee inlined at two call sites in one caller and again a level up."""
     scaled = njit(inline="always")(_scaled.py_func)
 
     @njit(inline="always")

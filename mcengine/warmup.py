@@ -28,6 +28,7 @@ import time
 import numpy as np
 
 from . import integrators, jit
+from .denoise import Denoising
 from .scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription
 
 __all__ = ["warm_up_scene", "compile_kernels", "is_compiled", "main"]
@@ -44,18 +45,27 @@ def is_compiled(integrator: str) -> bool:
 
 
 def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
-    """One quad under a point lamp, seen by a one-pixel camera: one sample of ``integrator``."""
-    quad = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
-                    np.float64)
+    """A floor and a ceiling, diffuse and a mirror both, with a point lamp of radius 0
+    between them, seen from below the ceiling by a one-pixel camera: a few samples of
+    ``integrator``, with the denoiser's guide passes.  Every kernel of the integrator runs,
+    so is compiled (``tests/core/test_warm_up_scene.py``): the lamp and the mirrors make
+    Path + Light Tracing trace light paths (``kernels.light_tracing.prepare``), and of its
+    64 light paths many reach the floor from the ceiling's mirror and join the camera."""
+    floor = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
+                     np.float64)
+    ceiling = floor[:, ::-1] + (0.0, 0.0, 2.5)       # facing down
     camera = np.eye(4)
-    camera[2, 3] = 3.0
+    camera[2, 3] = 2.2
     lamp = np.eye(4)
     lamp[:3, 3] = (0.5, 0.5, 2.0)
+    samples = 64 if integrators.get(integrator).light_tracing else 1
     return SceneDescription(
-        geometry=Geometry.from_triangles(quad), materials=[Material()],
-        lights=[Light(type="POINT", matrix_world=lamp, radius=0.1)],
+        denoising=Denoising(enabled=True),     # the denoiser's guide passes (not the denoiser)
+        geometry=Geometry.from_triangles(np.concatenate([floor, ceiling])),
+        materials=[Material(base_color=(0.4, 0.4, 0.4), mirror_color=(0.4, 0.4, 0.4))],
+        lights=[Light(type="POINT", matrix_world=lamp, radius=0.0)],
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
-        integrator=Integrator(name=integrator, samples=1))
+        integrator=Integrator(name=integrator, samples=samples))
 
 
 def _compile(names) -> None:

@@ -7,16 +7,17 @@ installed sources is not ready, so that the first F12 finds them compiled::
 
     python -m mcengine.warmup        # prints the seconds taken; exit 0 when ready
 
-It renders one sample of one pixel of a tiny scene with each integrator, the
-default one first (every shader node and closure is compiled with the shader
-evaluator, whatever the scene uses), then marks the cache ready
-(``jit.cache_is_ready``).  numba compiles on one core: once the shader evaluator,
-which every integrator calls, is in the cache, a second process
-(``python -m mcengine.warmup --only NAME...``) compiles the other integrators while
-this one compiles the default one.  Compiling every integrator here matters beyond the
-wait: numba compiling inside a Blender process where Cycles has rendered can
-crash that process (seen with bpy 5.0.1: a segfault in the next render), so a
-user's first Whitted render after a Cycles one must find its kernels compiled.
+It renders a few samples of one pixel of a tiny scene with each integrator
+(``warm_up_scene``: every kernel of the integrator runs), the default one first
+(every shader node and closure is compiled with the shader evaluator, whatever
+the scene uses), then marks the cache ready (``jit.cache_is_ready``).  numba
+compiles on one core: once the shader evaluator, which every integrator calls, is
+in the cache, a second process (``python -m mcengine.warmup --only NAME...``)
+compiles the other integrators while this one compiles the default one.
+Compiling every integrator here matters beyond the wait: numba compiling inside a
+Blender process where Cycles has rendered can crash that process (seen with bpy
+5.0.1: a segfault in the next render), so a user's first Whitted render after a
+Cycles one must find its kernels compiled.
 """
 from __future__ import annotations
 

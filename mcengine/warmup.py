@@ -30,7 +30,7 @@ import numpy as np
 
 from . import integrators, jit
 from .denoise import Denoising
-from .scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription
+from .scene import Camera, Film, Geometry, Integrator, Light, Link, Material, SceneDescription, ShaderNode
 
 __all__ = ["warm_up_scene", "compile_kernels", "is_compiled", "main"]
 
@@ -46,8 +46,8 @@ def is_compiled(integrator: str) -> bool:
 
 
 def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
-    """A floor and a ceiling, diffuse and a mirror both, with a point lamp of radius 0
-    between them, seen from below the ceiling by a one-pixel camera: a few samples of
+    """A floor and a ceiling (``_warm_up_material``) with a point lamp of radius 0 between
+    them, seen from below the ceiling by a one-pixel camera: a few samples of
     ``integrator``, with the denoiser's guide passes.  Every kernel of the integrator runs,
     so is compiled (``tests/core/test_warm_up_scene.py``): the lamp and the mirrors make
     Path + Light Tracing trace light paths (``kernels.light_tracing.prepare``), and of its
@@ -63,10 +63,22 @@ def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
     return SceneDescription(
         denoising=Denoising(enabled=True),     # the denoiser's guide passes (not the denoiser)
         geometry=Geometry.from_triangles(np.concatenate([floor, ceiling])),
-        materials=[Material(base_color=(0.4, 0.4, 0.4), mirror_color=(0.4, 0.4, 0.4))],
+        materials=[_warm_up_material()],
         lights=[Light(type="POINT", matrix_world=lamp, radius=0.0)],
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
         integrator=Integrator(name=integrator, samples=samples))
+
+
+def _warm_up_material() -> Material:
+    """Diffuse, a mirror and a little transparency: caustics for light tracing, and shadow
+    rays that test for transparent surfaces (``kernels.shadows.advance_shadows``)."""
+    grey = (0.4, 0.4, 0.4)
+    nodes = [ShaderNode("BsdfDiffuse", {"Color": grey}),
+             ShaderNode("BsdfGlossy", {"Color": grey, "Roughness": 0.0}, {"distribution": "GGX"}),
+             ShaderNode("BsdfTransparent", {"Color": (0.1, 0.1, 0.1)}),
+             ShaderNode("AddShader", {"Shader": Link(0, "BSDF"), "Shader_001": Link(1, "BSDF")}),
+             ShaderNode("AddShader", {"Shader": Link(3, "Shader"), "Shader_001": Link(2, "BSDF")})]
+    return Material(nodes=nodes, surface=Link(4, "Shader"))
 
 
 def _compile(names) -> None:

@@ -8,7 +8,7 @@ import functools
 import pytest
 
 from mcengine import integrators
-from mcengine.kernels import classic, light_tracing, path
+from mcengine.kernels import classic, light_tracing, path, shadows
 from mcengine.session import RenderSession
 from mcengine.warmup import warm_up_scene
 
@@ -24,7 +24,7 @@ def _kernels(module) -> list[str]:
 def test_the_warm_up_render_runs_every_kernel_of_the_integrator(name, monkeypatch):
     info = integrators.get(name)
     modules = [light_tracing] if info.light_tracing else []
-    modules.append(path if info.kernel_code == 0 else classic)     # as RenderSession._classic
+    modules += [path if info.kernel_code == 0 else classic, shadows]    # as RenderSession._classic
     called = set()
     expected = set()
     for module in modules:

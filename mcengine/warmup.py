@@ -72,13 +72,10 @@ def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
 def _warm_up_material() -> Material:
     """Diffuse, a mirror and a little transparency: caustics for light tracing, and shadow
     rays that test for transparent surfaces (``kernels.shadows.advance_shadows``)."""
-    grey = (0.4, 0.4, 0.4)
-    nodes = [ShaderNode("BsdfDiffuse", {"Color": grey}),
-             ShaderNode("BsdfGlossy", {"Color": grey, "Roughness": 0.0}, {"distribution": "GGX"}),
-             ShaderNode("BsdfTransparent", {"Color": (0.1, 0.1, 0.1)}),
-             ShaderNode("AddShader", {"Shader": Link(0, "BSDF"), "Shader_001": Link(1, "BSDF")}),
-             ShaderNode("AddShader", {"Shader": Link(3, "Shader"), "Shader_001": Link(2, "BSDF")})]
-    return Material(nodes=nodes, surface=Link(4, "Shader"))
+    nodes, surface = Material(base_color=(0.4, 0.4, 0.4), mirror_color=(0.4, 0.4, 0.4)).graph()
+    nodes.append(ShaderNode("BsdfTransparent", {"Color": (0.1, 0.1, 0.1)}))
+    nodes.append(ShaderNode("AddShader", {"Shader": surface, "Shader_001": Link(len(nodes) - 1, "BSDF")}))
+    return Material(nodes=nodes, surface=Link(len(nodes) - 1, "Shader"))
 
 
 def _compile(names) -> None:
@@ -88,17 +85,17 @@ def _compile(names) -> None:
         _marker(name).touch()
 
 
-def compile_kernels(processes: int = 2) -> float:
+def compile_kernels() -> float:
     """Compile (or load) every integrator's kernels, the default one first; seconds taken.
 
-    With two ``processes``, the others are compiled by a second process once this one has
-    put the shader evaluator into the cache."""
+    The others are compiled by a second process once this one has put the shader
+    evaluator into the cache."""
     from .packing import pack_scene
     start = time.perf_counter()
     names = sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT)
     helper = None
     try:
-        if processes > 1 and len(names) > 1:
+        if len(names) > 1:
             pack_scene(warm_up_scene())        # compiles the shader evaluator
             names, others = names[:1], names[1:]
             helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *others],

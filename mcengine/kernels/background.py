@@ -39,7 +39,7 @@ def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
     # Every field of the type shading.shading_data gives it (float64, bool, int64), so that
     # the shader evaluator is compiled once for surfaces and the world.
     i64 = np.int64
-    x, y, z = float(dx), float(dy), float(dz)
+    x, y, z = np.float64(dx), np.float64(dy), np.float64(dz)
     sd = ShadingData(x, y, z, -x, -y, -z, -x, -y, -z, -x, -y, -z, False, False, True, True, False,
                      i64(-1), 0.0, 0.0, i64(-1), i64(flags), math.inf,
                      i64(0), i64(0), i64(0), i64(0), i64(0), 0.0)

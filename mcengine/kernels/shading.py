@@ -322,16 +322,17 @@ def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
 def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b1, b2, obj, flags,
                  ray_length, depths, dp):
     """The ``ShadingData`` of surface point ``sp`` for a ray of direction d, every field of
-    one fixed type (float64, bool, int64; numba's int() would keep an int32 an int32),
-    whatever its callers pass: the shader evaluator and every node function it calls are then
-    compiled once, not once per combination of argument types (and the compiler's folding
-    ahead of time, from Python values, uses the same compiled code)."""
-    i64 = np.int64
+    one fixed type (float64, bool, int64; numba's int() and float() would keep an int32 an
+    int32 and a float32 a float32), whatever its callers pass: the shader evaluator and
+    every node function it calls are then compiled once, not once per combination of
+    argument types (and the compiler's folding ahead of time, from Python values, uses the
+    same compiled code)."""
+    i64, f64 = np.int64, np.float64
     return ShadingData(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, sp.ngx, sp.ngy, sp.ngz,
-                       -dx, -dy, -dz, bool(sp.backfacing), bool(allocate), bool(reflective),
-                       bool(refractive), bool(bump), i64(prim), float(b1), float(b2), i64(obj),
-                       i64(flags), float(ray_length), i64(depths[0]), i64(depths[1]),
-                       i64(depths[2]), i64(depths[3]), i64(depths[4]), float(dp))
+                       -f64(dx), -f64(dy), -f64(dz), bool(sp.backfacing), bool(allocate),
+                       bool(reflective), bool(refractive), bool(bump), i64(prim), f64(b1), f64(b2),
+                       i64(obj), i64(flags), f64(ray_length), i64(depths[0]), i64(depths[1]),
+                       i64(depths[2]), i64(depths[3]), i64(depths[4]), f64(dp))
 
 
 @device

@@ -68,8 +68,12 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         if not (sc.mat_flags[m] & MF_TRANSPARENT) or sq.transparent[s] <= 0:
             sq.alive[s] = SHADOW_BLOCKED
             continue
-        ox, oy, oz = sq.o32[s, 0], sq.o32[s, 1], sq.o32[s, 2]
-        dx, dy, dz = sq.d32[s, 0], sq.d32[s, 1], sq.d32[s, 2]
+        # In float64 from here (numba's float() would keep float32): the shader evaluator
+        # and the functions below are then the ones the integrators compiled (a float32 d
+        # compiled another copy of each, about 2 minutes).
+        f64 = np.float64
+        ox, oy, oz = f64(sq.o32[s, 0]), f64(sq.o32[s, 1]), f64(sq.o32[s, 2])
+        dx, dy, dz = f64(sq.d32[s, 0]), f64(sq.d32[s, 1]), f64(sq.d32[s, 2])
         ax, ay, az, bx, by, bz, cx, cy, cz = prim_corners(sc, p, sq.time[s])
         t, b1, b2 = intersect_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz)
         if not math.isfinite(t):

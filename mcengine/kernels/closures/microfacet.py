@@ -529,8 +529,9 @@ def microfacet_sample(cl, k, wox, woy, woz, u1, u2, u3):
         label = LABEL_REFLECT
     energy = cl[k, CL_ENERGY] if dist == MD_GGX else 1.0
     if singular:
-        w = energy / lobe
-        return wix, wiy, wiz, cr * w, cg * w, cb * w, 0.0, label | LABEL_SINGULAR
+        # R / P_R, divided last: with a subnormal R (and P_R), 1 / P_R alone overflows.
+        return (wix, wiy, wiz, cr * energy / lobe, cg * energy / lobe, cb * energy / lobe, 0.0,
+                label | LABEL_SINGULAR)
     if refract:
         ax = ay = math.sqrt(ax * ay)      # transmission is isotropic
     d = microfacet_D(dist, ax, ay, hx, hy, hz)

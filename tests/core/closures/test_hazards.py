@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from mcengine.kernels.closures.layout import (
@@ -77,6 +77,8 @@ def _check(cl, wo, u, white):
 @given(kind=kinds, dist=st.sampled_from([MD_GGX, MD_BECKMANN]), r=roughness, r2=roughness, eta=etas,
        cos_t=cosines, phi=st.floats(0.0, 2 * math.pi), u1=uniforms, u2=uniforms, u3=uniforms,
        f0=st.floats(0.0, 1.0), b=st.floats(-1.0, 2.0), exponent=st.one_of(st.just(-1.0), st.floats(0.0, 1e4)))
+@example(kind=(CT_MICROFACET_GLASS, FR_SCHLICK), dist=MD_GGX, r=0.0, r2=0.0, eta=1.0, cos_t=1e-7,
+         phi=0.0, u1=0.0, u2=0.0, u3=0.0, f0=5e-324, b=0.0, exponent=-1.0)   # was inf: R / P_R
 def test_microfacet_hazards(kind, dist, r, r2, eta, cos_t, phi, u1, u2, u3, f0, b, exponent):
     ctype, fresnel = kind
     cl = microfacet_row(ctype=ctype, dist=dist, alpha=r * r, alpha_y=r2 * r2 if ctype == CT_MICROFACET else None,

@@ -68,13 +68,15 @@ from .kernels.svm import (
     OBJ_PASS_INDEX,
     OBJ_RANDOM,
     OBJ_STRIDE,
+    OBJ_TERMINATOR_GEOMETRY,
+    OBJ_TERMINATOR_SHADING,
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
     OP_NODE,
     TextureData,
 )
 from .passes import kernel_data, motion_corners, world_to_raster
-from .scene import SceneDescription
+from .scene import DEFAULT_TERMINATOR_OFFSETS, SceneDescription
 from .shaders import AttributeLayout, ShaderTable
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
@@ -265,6 +267,10 @@ def pack_objects(g) -> np.ndarray:
         out[:o, OBJ_RANDOM] = info[:, 0]
         out[:o, OBJ_PASS_INDEX] = info[:, 1]
         out[:o, OBJ_COLOR:OBJ_COLOR + 4] = info[:, 2:6]
+    terminator = g.terminator_offsets() if o else np.array([DEFAULT_TERMINATOR_OFFSETS])
+    out[:, OBJ_TERMINATOR_GEOMETRY] = terminator[:, 0]
+    # Cycles keeps the Shading Offset s as the frequency of its shift_cos_in (scene/object.cpp).
+    out[:, OBJ_TERMINATOR_SHADING] = 1.0 / (1.0 - 0.5 * terminator[:, 1])
     return out
 
 

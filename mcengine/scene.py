@@ -48,6 +48,8 @@ AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
 FILTER_TYPES = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
 IMAGE_COLORSPACES = ("sRGB", "linear", "data")
 IMAGE_ALPHA_MODES = ("STRAIGHT", "PREMUL", "CHANNEL_PACKED", "NONE")
+# An object's Shadow Terminator Geometry Offset and Shading Offset, Blender's defaults.
+DEFAULT_TERMINATOR_OFFSETS = (0.1, 0.0)
 
 
 class SceneError(ValueError):
@@ -87,6 +89,8 @@ class Geometry:
     object_texspace (O, 2, 3) float64  generated texture space: centre and half-size
                     (object space; Blender's texspace_location and texspace_size)
     object_info     (O, 6) float64     Object Info: random, pass index, colour RGBA
+    object_terminator (O, 2) float64   Shadow Terminator: Geometry Offset and Shading Offset,
+                    each in [0, 1] (``DEFAULT_TERMINATOR_OFFSETS`` when absent)
     object_passes   per entry of ``object_names``, its :class:`ObjectPassInfo` (render passes;
                     empty: each object is named by its ``object_names`` entry)
     """
@@ -102,6 +106,7 @@ class Geometry:
     object_matrix: np.ndarray | None = None
     object_texspace: np.ndarray | None = None
     object_info: np.ndarray | None = None
+    object_terminator: np.ndarray | None = None
     object_passes: list = field(default_factory=list)
 
     @property
@@ -131,6 +136,12 @@ class Geometry:
             texspace[seen, 0] = 0.5 * (lo[seen] + hi[seen])
             texspace[seen, 1] = 0.5 * (hi[seen] - lo[seen])
         return matrix, auto_texspace_size(texspace), info
+
+    def terminator_offsets(self) -> np.ndarray:
+        """(O, 2) float64: each object's Shadow Terminator offsets, the defaults filled in."""
+        if self.object_terminator is not None:
+            return np.asarray(self.object_terminator, np.float64)
+        return np.tile(DEFAULT_TERMINATOR_OFFSETS, (self.num_objects, 1))
 
     def object_pass_info(self) -> list:
         """An :class:`ObjectPassInfo` per entry of ``object_names``."""
@@ -205,7 +216,9 @@ class Geometry:
             object_index=np.concatenate(objs), object_names=names, attributes=attributes,
             object_matrix=np.concatenate([o[0] for o in objects]),
             object_texspace=np.concatenate([o[1] for o in objects]),
-            object_info=np.concatenate([o[2] for o in objects]), object_passes=infos)
+            object_info=np.concatenate([o[2] for o in objects]),
+            object_terminator=np.concatenate([g.terminator_offsets() for g in parts]),
+            object_passes=infos)
 
 
 def auto_texspace_size(texspace: np.ndarray) -> np.ndarray:
@@ -614,12 +627,16 @@ class SceneDescription:
         if t and (g.object_index.min() < 0 or g.object_index.max() >= max(o, 1)):
             raise SceneError("geometry.object_index refers to an object that does not exist")
         for name, shape in (("object_matrix", (o, 4, 4)), ("object_texspace", (o, 2, 3)),
-                            ("object_info", (o, 6))):
+                            ("object_info", (o, 6)), ("object_terminator", (o, 2))):
             a = getattr(g, name)
             if a is None:
                 continue
             if np.shape(a) != shape or not np.all(np.isfinite(a)):
                 raise SceneError(f"geometry.{name} must be finite with shape {shape}")
+        if g.object_terminator is not None and not np.all(
+                (np.asarray(g.object_terminator) >= 0.0) & (np.asarray(g.object_terminator) <= 1.0)):
+            raise SceneError("geometry.object_terminator: the Shadow Terminator offsets must lie "
+                             "in [0, 1]")
         if g.object_matrix is not None and o and np.any(
                 np.abs(np.linalg.det(np.asarray(g.object_matrix)[:, :3, :3])) < 1e-300):
             raise SceneError("geometry.object_matrix has a singular matrix (an object scaled to 0)")
@@ -765,7 +782,8 @@ class SceneDescription:
         np.savez_compressed(
             path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
-            object_matrix=matrix, object_texspace=texspace, object_info=info, **attributes,
+            object_matrix=matrix, object_texspace=texspace, object_info=info,
+            object_terminator=g.terminator_offsets(), **attributes,
             **images, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
 
     @staticmethod
@@ -802,7 +820,7 @@ _SAVED_ARRAYS = {
     "meta": ("u", ()),
 }
 _OPTIONAL_ARRAYS = {"object_matrix": ("f", (4, 4)), "object_texspace": ("f", (2, 3)),
-                    "object_info": ("f", (6,))}
+                    "object_info": ("f", (6,)), "object_terminator": ("f", (2,))}
 MAX_META_BYTES = 64 << 20
 
 
@@ -850,7 +868,7 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
                     object_index=z["object_index"], object_names=list(meta["object_names"]),
                     attributes={str(name): z[f"attribute{k}"] for k, name in enumerate(names)},
                     object_matrix=z.get("object_matrix"), object_texspace=z.get("object_texspace"),
-                    object_info=z.get("object_info"),
+                    object_info=z.get("object_info"), object_terminator=z.get("object_terminator"),
                     object_passes=[ObjectPassInfo(**o) for o in meta.get("object_passes", [])])
     lights = []
     for d in meta["lights"]:

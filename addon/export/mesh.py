@@ -27,7 +27,6 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from mcengine.kernels.shading import SHADOW_TERMINATOR_OFFSET
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.mesh_attributes import pointiness, random_per_island
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
@@ -46,8 +45,6 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "holdout/shadow catcher": "these objects render as normal objects",
-    "shadow terminator offsets other than the default": "these objects use Geometry Offset 0.1 "
-                                                        "and Shading Offset 0",
     "normal maps without a UV map": "their normal maps leave the normal unchanged (Cycles takes "
                                     "tangents from generated coordinates there)",
 }
@@ -126,6 +123,7 @@ class MeshCollector:
         self._infos: dict[tuple, list] = {}
         self._passes: dict[tuple, list] = {}
         self._tags: dict[tuple, list] = {}
+        self._terminators: dict[tuple, list] = {}
         # Per geometry object, after geometry(): (tag, (first vertex, count), LocalMesh, slots, matrix).
         self.layout: list = []
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
@@ -152,10 +150,6 @@ class MeshCollector:
             self._note("ray visibility", ob.name)
         if getattr(ob, "is_holdout", False) or getattr(ob, "is_shadow_catcher", False):
             self._note("holdout/shadow catcher", ob.name)
-        offset = getattr(ob, "shadow_terminator_geometry_offset", SHADOW_TERMINATOR_OFFSET)
-        if (abs(offset - SHADOW_TERMINATOR_OFFSET) > 1e-6
-                or getattr(ob, "shadow_terminator_shading_offset", 0.0) != 0.0):
-            self._note("shadow terminator offsets other than the default", ob.name)
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
@@ -165,7 +159,7 @@ class MeshCollector:
             if mesh is not None and mesh.tangents_failed:
                 self._note(mesh.tangents_failed, ob.name)
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
-            self._passes[key], self._tags[key] = [], []
+            self._passes[key], self._tags[key], self._terminators[key] = [], [], []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
@@ -174,6 +168,8 @@ class MeshCollector:
                                      *(float(c) for c in ob.color)])
             self._passes[key].append(object_pass_info(ob))
             self._tags[key].append(tag)
+            self._terminators[key].append((ob.shadow_terminator_geometry_offset,
+                                           ob.shadow_terminator_shading_offset))
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -188,6 +184,9 @@ class MeshCollector:
         geometry = _place_all(parts, self._ctx.unit_scale)
         geometry.object_passes = [info for key, mesh in self._meshes.items() if mesh is not None
                                   for info in self._passes[key]]
+        geometry.object_terminator = np.array(
+            [t for key, mesh in self._meshes.items() if mesh is not None
+             for t in self._terminators[key]], np.float64).reshape(-1, 2)
         # The instances' places in the geometry, in the order _place_all writes them.
         self.layout = []
         first = 0

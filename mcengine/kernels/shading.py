@@ -43,6 +43,7 @@ from .closures import (
     bsdf_eval,
     bsdf_sample_closure,
 )
+from .closures.layout import CL_TERMINATOR
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
     PMF_EVERY,
@@ -87,12 +88,15 @@ from .state import (
     ST_NONFINITE,
 )
 from .surface import smooth_surface_offset, surface_point
-from .svm import BUMP_SET_NORMAL, OP_BUMP, ShadingData, eval_closure_rows, eval_shader
-
-# Blender's default Shadow Terminator > Geometry Offset of an object: the cosine under which
-# shadow rays start from the smooth surface (``terminator_origin``).  Cycles reads it per
-# object; the add-on warns when an object sets another value.
-SHADOW_TERMINATOR_OFFSET = 0.1
+from .svm import (
+    BUMP_SET_NORMAL,
+    OBJ_TERMINATOR_GEOMETRY,
+    OBJ_TERMINATOR_SHADING,
+    OP_BUMP,
+    ShadingData,
+    eval_closure_rows,
+    eval_shader,
+)
 
 DirectionSample = namedtuple("DirectionSample", [
     "ok",                    # False: no direction (absorbed, or through the wrong side)
@@ -158,19 +162,21 @@ def shader_normal(sc, regs, sp):
 @device
 def terminator_origin(sc, sp, nx, ny, nz, wix, wiy, wiz):
     """Where a shadow ray towards wi starts on a smooth-shaded triangle: Cycles'
-    shadow_ray_offset with Blender's default Shadow Terminator Geometry Offset.  Where the
-    light is at most that cosine above the flat triangle (or above the shader's normal n),
-    the ray starts from the curved surface the corner normals describe
-    (``surface.smooth_surface_offset``) rather than from the facet, in full once the
-    light is below the facet; so a lit smooth (or bumped) surface is not shadowed by its
-    own facets near the terminator."""
+    shadow_ray_offset with the object's Shadow Terminator Geometry Offset (0.1 by default;
+    0: never).  Where the light is at most that cosine above the flat triangle (or above
+    the shader's normal n), the ray starts from the curved surface the corner normals
+    describe (``surface.smooth_surface_offset``) rather than from the facet, in full once
+    the light is below the facet; so a lit smooth (or bumped) surface is not shadowed by
+    its own facets near the terminator."""
     nl = nx * wix + ny * wiy + nz * wiz
     ngx, ngy, ngz = sp.ngx, sp.ngy, sp.ngz
     if nl < 0.0:
         nl = -nl
         ngx, ngy, ngz = -ngx, -ngy, -ngz
     ngl = ngx * wix + ngy * wiy + ngz * wiz
-    cutoff = SHADOW_TERMINATOR_OFFSET
+    cutoff = sc.tex.objects[sc.tex.tri_object[sp.prim], OBJ_TERMINATOR_GEOMETRY]
+    if not cutoff > 0.0:
+        return sp.hx, sp.hy, sp.hz
     amount = 2.0 - (ngl + nl) / cutoff if nl < cutoff else 1.0 - ngl / cutoff
     amount = min(max(amount, 0.0), 1.0)
     if amount <= 0.0:
@@ -344,20 +350,28 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
     glossy, transmission, transparent) and the ray differential's ``footprint`` there (0: none,
     the Bump node then leaves the normal unchanged).
 
-    The closures go to ``scratch.cl``; returns the ``ShaderResult``.  With
+    The closures go to ``scratch.cl``, each with the object's Shadow Terminator Shading
+    Offset (``closures.shift_cos_in``); returns the ``ShaderResult``.  With
     ``allocate`` false only emission, transparency and holdout are computed.
     """
     from_diffuse = (flags & PF_DIFFUSE) != 0
+    obj = sc.tex.tri_object[p]
     sd = shading_data(sp, dx, dy, dz, allocate,
                       cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
                       cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
                       (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
-                      p, b1, b2, sc.tex.tri_object[p], flags, t_hit, depths, footprint)
+                      p, b1, b2, obj, flags, t_hit, depths, footprint)
     if sc.mat_flags[m] & MF_CLOSURES_ONLY:
-        return eval_closure_rows(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                                 scratch.cl, sd)
-    return eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl,
-                       sd, sc.tex, sc.verts, sc.tris)
+        res = eval_closure_rows(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
+                                scratch.cl, sd)
+    else:
+        res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
+                          scratch.cl, sd, sc.tex, sc.verts, sc.tris)
+    frequency = sc.tex.objects[obj, OBJ_TERMINATOR_SHADING]
+    if frequency > 1.0:
+        for k in range(res.n):
+            scratch.cl[k, CL_TERMINATOR] = frequency
+    return res
 
 
 @device

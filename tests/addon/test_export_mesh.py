@@ -276,14 +276,17 @@ def test_hair_and_visibility_settings_are_named_once(scene, fake_session):
                      "'Ghost4' and 2 more); these objects are visible to all rays"]
 
 
-def test_shadow_terminator_offsets_other_than_the_default_are_named(scene, fake_session):
+def test_each_objects_shadow_terminator_offsets_are_exported(scene, fake_session):
+    """Geometry and Shading Offset per object (what they render: test_bump_nodes.py)."""
     new_mesh_object("Default", TRI, [(0, 1, 2)])
     new_mesh_object("Geometry", TRI, [(0, 1, 2)]).shadow_terminator_geometry_offset = 0.3
     new_mesh_object("Shading", TRI, [(0, 1, 2)]).shadow_terminator_shading_offset = 0.2
     desc = export_scene(fake_session)
-    assert [w for w in desc.warnings if "terminator" in w] == [
-        "shadow terminator offsets other than the default not supported yet ('Geometry', "
-        "'Shading'); these objects use Geometry Offset 0.1 and Shading Offset 0"]
+    g = desc.geometry
+    offsets = dict(zip(g.object_names, g.terminator_offsets().tolist()))
+    np.testing.assert_allclose([offsets["Default"], offsets["Geometry"], offsets["Shading"]],
+                               [[0.1, 0.0], [0.3, 0.0], [0.1, 0.2]], rtol=1e-6)
+    assert not [w for w in desc.warnings if "terminator" in w]
 
 
 def _attribute_grid(n=6):

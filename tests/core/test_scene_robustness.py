@@ -49,6 +49,25 @@ def test_validation_refuses_non_finite_and_out_of_range_values(where, attr, valu
         scene.validate()
 
 
+@pytest.mark.parametrize("offsets", [[[1.5, 0.0]], [[0.1, -0.2]], [[NAN, 0.0]], [[0.1, 0.0, 0.0]],
+                                     [[0.1, 0.0], [0.1, 0.0]]])
+def test_validation_refuses_shadow_terminator_offsets_blender_does_not_allow(offsets):
+    """Blender keeps both offsets in [0, 1] (a Shading Offset of 2 would divide by zero)."""
+    scene = _scene()
+    assert scene.geometry.num_objects == 1
+    scene.geometry.object_terminator = np.array(offsets)
+    with pytest.raises(SceneError, match="object_terminator"):
+        scene.validate()
+
+
+def test_saved_scene_keeps_each_objects_terminator_offsets(tmp_path):
+    scene = _scene()
+    scene.geometry.object_terminator = np.array([[0.4, 0.7]])
+    scene.save(tmp_path / "scene.npz")
+    loaded = SceneDescription.load(tmp_path / "scene.npz")
+    np.testing.assert_array_equal(loaded.geometry.terminator_offsets(), [[0.4, 0.7]])
+
+
 def _saved(tmp_path, scene=None) -> bytes:
     path = tmp_path / "scene.npz"
     (scene or inside_sphere_scene(samples=1, res=4)).save(path)

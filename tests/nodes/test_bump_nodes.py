@@ -230,25 +230,34 @@ def test_fine_bump_depends_on_the_filter_width(perspective_images):
     assert np.abs(a - b).max() > 0.05
 
 
-TERMINATOR_SPHERES = ("smooth", "bumped", "bump node")     # top to bottom in the image
+TERMINATOR_SPHERES = ("smooth", "bumped", "bump node",    # top to bottom in the image
+                      "geometry offset 0", "shading offset 0.6", "shading offset 1")
 
 
 def _lit_spheres():
-    """Two low-poly smooth spheres (12 x 6 faces, so the shading normals lean up to 15 deg
-    off the facets) under a sun from +x (a little from above), seen from -y by an orthographic camera, so their
-    shadow terminators run down the middle of the image: a plain white diffuse one, one
-    whose displacement is rendered as bump (Wave bands on object coordinates), which tilts
-    the normal towards the sun well past the facets' terminator, and one whose Diffuse BSDF
-    takes the same bump through its Normal input (a Bump node), which the offset ignores:
-    Cycles measures the light against the shader's normal sd->N, not a closure's.  No bounces, black world,
-    one sample at each pixel centre: every pixel is the sun's light through one shadow ray."""
+    """Low-poly smooth spheres (12 x 6 faces, so the shading normals lean up to 15 deg off
+    the facets) under a sun from +x (a little from above), seen from -y by an orthographic
+    camera, so their shadow terminators run down the middle of the image: a plain white
+    diffuse one; one whose displacement is rendered as bump (Wave bands on object
+    coordinates), which tilts the normal towards the sun well past the facets' terminator;
+    one whose Diffuse BSDF takes the same bump through its Normal input (a Bump node), which
+    the offset ignores: Cycles measures the light against the shader's normal sd->N, not a
+    closure's; then plain ones with the object's Shadow Terminator settings changed: Geometry
+    Offset 0 (no shadow ray starts from the smooth surface; on a convex sphere any other
+    value lights the same pixels: where the light is below a facet, every one offsets the
+    ray in full) and Shading Offset 0.6 and 1 (the diffuse light falls off faster towards
+    the terminator).  No bounces,
+    black world, one sample at each pixel centre: every pixel is the sun's light through one
+    shadow ray."""
     import bpy
 
-    scene = pixel_centre_scene(48, 144)
+    rows = len(TERMINATOR_SPHERES)
+    scene = pixel_centre_scene(48, 48 * rows)
     cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
     cam.data.type = "ORTHO"
-    cam.data.ortho_scale = 7.2
-    cam.location, cam.rotation_euler = (0.0, -10.0, 0.0), (math.pi / 2, 0.0, 0.0)
+    cam.data.ortho_scale = 2.4 * rows
+    cam.location = (0.0, -10.0, 2.4 - 1.2 * (rows - 1))
+    cam.rotation_euler = (math.pi / 2, 0.0, 0.0)
     scene.collection.objects.link(cam)
     scene.camera = cam
     black_world(scene)
@@ -261,6 +270,10 @@ def _lit_spheres():
                                              location=(0.0, 0.0, 2.4 - 2.4 * k))
         ob = bpy.context.active_object
         bpy.ops.object.shade_smooth()
+        if kind.startswith("geometry offset"):
+            ob.shadow_terminator_geometry_offset = float(kind.split()[-1])
+        elif kind.startswith("shading offset"):
+            ob.shadow_terminator_shading_offset = float(kind.split()[-1])
         mat = bpy.data.materials.new(f"m{k}")
         mat.use_nodes = True
         nt = mat.node_tree
@@ -268,7 +281,7 @@ def _lit_spheres():
         diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
         diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
         nt.links.new(diffuse.outputs["BSDF"], out.inputs["Surface"])
-        if kind != "smooth":
+        if kind in ("bumped", "bump node"):
             wave = nt.nodes.new("ShaderNodeTexWave")
             wave.inputs["Scale"].default_value = 2.0
             tc = nt.nodes.new("ShaderNodeTexCoord")
@@ -301,8 +314,11 @@ def test_shadow_terminator_offset_agrees_with_cycles(lit_spheres, kind):
     Cycles starts the shadow ray from the smooth surface the corner normals describe
     (Shadow Terminator Geometry Offset, 0.1 by default), so much of that band is lit; from
     the facet itself the ray is blocked by the sphere.  Before MC Engine did the same, its
-    bumped sphere rendered 0.9 % darker than Cycles' (texture_bump at 100 %)."""
+    bumped sphere rendered 0.9 % darker than Cycles' (texture_bump at 100 %); before it read
+    each object's offsets, the last three spheres rendered as the first."""
     k = TERMINATOR_SPHERES.index(kind)
     ref, ours = (img[48 * k:48 * (k + 1)] for img in lit_spheres)
-    assert (ref.max(axis=2) > 0.05).mean() > 0.1          # the lit side is in view
+    assert (ref.max(axis=2) > 0.05).mean() > 0.03         # the lit side is in view
+    if "offset" in kind:               # Cycles renders the setting: not the default sphere
+        assert np.abs(ref - lit_spheres[0][:48]).max() > 0.01
     assert_agree(kind, ref, ours, rel=1e-3, abs_tol=1e-4, edge_fraction=0.0)

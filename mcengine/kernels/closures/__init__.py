@@ -19,7 +19,9 @@ Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
 
 Every closure whose normal differs from the point's smooth normal (a normal map,
 Bump Map Correction's lift of a glossy normal) carries Cycles' bump shadowing
-term (``bump_shadowing``), in ``closure_eval`` and ``closure_sample``.
+term (``bump_shadowing``), in ``closure_eval`` and ``closure_sample``; on an object
+with a Shadow Terminator Shading Offset, every closure's value is also scaled by
+``shift_cos_in`` there.
 
 Directions passed here are in world space: ``wo`` towards the viewer, ``wi``
 towards the light or the sampled direction.
@@ -44,6 +46,7 @@ from .layout import (
     CL_NS,
     CL_SW,
     CL_T,
+    CL_TERMINATOR,
     CL_TYPE,
     CL_W,
     CT_DIFFUSE,
@@ -122,6 +125,19 @@ def bump_shadowing(cl, k, diffuse, is_eval, wix, wiy, wiz):
     return 1.0 / (1.0 + ggx_lambda_q(alpha2 * max(1.0 / (cos_i * cos_i) - 1.0, 0.0)))
 
 
+@device
+def shift_cos_in(cos_in, frequency):
+    """Cycles' shift_cos_in (from appleseed), the Shadow Terminator Shading Offset: the
+    factor cos(frequency * theta_i) / cos(theta_i) on a closure's value towards a direction
+    theta_i from its normal (frequency 1 / (1 - offset / 2) > 1 moves the diffuse terminator
+    towards the light, where it is 0 from theta_i = pi / (2 frequency) on).  Cycles divides
+    by a zero cosine; here a direction at or below the surface keeps its value."""
+    if not cos_in > 0.0:
+        return 1.0
+    cos_in = min(cos_in, 1.0)
+    return max(math.cos(math.acos(cos_in) * frequency), 0.0) / cos_in
+
+
 @function
 def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
     """(r, g, b, pdf) of closure k for world directions, without its weight (times the bump
@@ -145,6 +161,8 @@ def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
         r, g, b, pdf = microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
     else:
         return 0.0, 0.0, 0.0, 0.0
+    if cl[k, CL_TERMINATOR] > 1.0:
+        shadowing *= shift_cos_in(liz, cl[k, CL_TERMINATOR])
     return r * shadowing, g * shadowing, b * shadowing, pdf
 
 
@@ -170,8 +188,10 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
     else:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     wix, wiy, wiz = x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz
-    if not (label & LABEL_TRANSMIT):     # Cycles leaves transmitted samples without the term
+    if not (label & LABEL_TRANSMIT):     # Cycles leaves transmitted samples without these terms
         shadowing = bump_shadowing(cl, k, is_diffuse(t), False, wix, wiy, wiz)
+        if cl[k, CL_TERMINATOR] > 1.0:
+            shadowing *= shift_cos_in(z, cl[k, CL_TERMINATOR])
         r, g, b = r * shadowing, g * shadowing, b * shadowing
     return wix, wiy, wiz, r, g, b, pdf, label
 

@@ -49,7 +49,8 @@ CL_P4 = 34
 CL_ALBEDO = 36           # 3: microfacet: the albedo estimate at the view, from the setup (layering)
 CL_NS = 39               # 3: the point's smooth (interpolated, not normal-mapped) normal, viewer's side
 CL_BUMP_CORRECTION = 42  # 1: the material's Bump Map Correction is on (softens diffuse closures)
-CL_STRIDE = 43
+CL_TERMINATOR = 43       # the object's Shadow Terminator Shading Offset as a frequency (> 1: on)
+CL_STRIDE = 44
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0

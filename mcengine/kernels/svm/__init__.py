@@ -54,6 +54,8 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     OBJ_PASS_INDEX,
     OBJ_RANDOM,
     OBJ_STRIDE,
+    OBJ_TERMINATOR_GEOMETRY,
+    OBJ_TERMINATOR_SHADING,
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
     ShadingData,

@@ -10,10 +10,12 @@ installed sources is not ready, so that the first F12 finds them compiled::
 It renders a few samples of one pixel of a tiny scene with each integrator
 (``warm_up_scene``: every kernel of the integrator runs), the default one first
 (every shader node and closure is compiled with the shader evaluator, whatever
-the scene uses), then marks the cache ready (``jit.cache_is_ready``).  numba
-compiles on one core: once the shader evaluator, which every integrator calls, is
-in the cache, a second process (``python -m mcengine.warmup --only NAME...``)
-compiles the other integrators while this one compiles the default one.
+the scene uses), and one of a scene with what else a render may compile
+(``features_scene``: motion blur, a world and a mesh light whose radiance varies),
+then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core:
+once the shader evaluator, which every integrator calls, is in the cache, a second
+process (``python -m mcengine.warmup --only NAME...``) compiles the other
+integrators while this one compiles the default integrator and the features.
 Compiling every integrator here matters beyond the wait: numba compiling inside a
 Blender process where Cycles has rendered can crash that process (seen with bpy
 5.0.1: a segfault in the next render), so a user's first Whitted render after a
@@ -30,9 +32,24 @@ import numpy as np
 
 from . import integrators, jit
 from .denoise import Denoising
-from .scene import Camera, Film, Geometry, Integrator, Light, Link, Material, SceneDescription, ShaderNode
+from .scene import (
+    Camera,
+    Film,
+    Geometry,
+    Integrator,
+    Light,
+    Link,
+    Material,
+    MotionBlur,
+    ObjectMotion,
+    SceneDescription,
+    ShaderNode,
+    World,
+)
 
-__all__ = ["warm_up_scene", "compile_kernels", "is_compiled", "main"]
+__all__ = ["warm_up_scene", "features_scene", "compile_kernels", "is_compiled", "main"]
+
+FEATURES = "features"      # the warm-up step that renders ``features_scene``
 
 
 def _marker(integrator: str):
@@ -40,9 +57,10 @@ def _marker(integrator: str):
 
 
 def is_compiled(integrator: str) -> bool:
-    """True once this module has compiled ``integrator``'s kernels for these sources (a
-    render of it then only loads them, while the warm-up may go on with the others)."""
-    return _marker(integrator).exists()
+    """True once this module has compiled ``integrator``'s kernels and the features' for
+    these sources (a render of it then only loads them, while the warm-up may go on with
+    the other integrators)."""
+    return _marker(integrator).exists() and _marker(FEATURES).exists()
 
 
 def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
@@ -78,30 +96,60 @@ def _warm_up_material() -> Material:
     return Material(nodes=nodes, surface=Link(len(nodes) - 1, "Shader"))
 
 
-def _compile(names) -> None:
+def features_scene() -> SceneDescription:
+    """What a render may compile besides its integrator's kernels, rendered by the default
+    integrator (``tests/core/test_warm_up_scene.py`` checks each runs): a world whose
+    radiance varies (its importance map is baked, ``kernels.background``), a square that
+    emits a gradient (a mesh light whose emission varies: ``kernels.shading.emission_estimates``
+    weighs it) and moves while the shutter is open (motion blur: ``kernels.motion``), above
+    the warm-up's floor."""
+    floor = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
+                     np.float64)
+    lamp = floor[:, ::-1] * 0.2 + (0.0, 0.0, 1.0)         # facing down
+    gradient = [ShaderNode("TexGradient")]
+    emission = Material(name="lamp", nodes=gradient + [ShaderNode("Emission", {"Color": Link(0, "Color")})],
+                        surface=Link(1, "Emission"))
+    world = World(nodes=gradient + [ShaderNode("Background", {"Color": Link(0, "Color")})],
+                  surface=Link(1, "Background"))
+    steps = np.stack([np.eye(4)] * 3)
+    steps[:, 0, 3] = (-0.1, 0.0, 0.1)
+    camera = np.eye(4)
+    camera[2, 3] = 0.5
+    return SceneDescription(
+        geometry=Geometry.from_triangles(np.concatenate([floor, lamp]), material_index=[0, 0, 1, 1],
+                                         object_index=[0, 0, 1, 1], object_names=["floor", "lamp"]),
+        materials=[Material(), emission], world=world,
+        motion_blur=MotionBlur(objects=[ObjectMotion(object=1, vertices=(6, 6), matrices=steps)]),
+        camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
+        integrator=Integrator(samples=4))
+
+
+def _compile(steps) -> None:
+    """Render each step's scene: an integrator's ``warm_up_scene``, or ``features_scene``."""
     from .session import RenderSession
-    for name in names:
-        RenderSession(warm_up_scene(name), threads=1).run()
-        _marker(name).touch()
+    for step in steps:
+        scene = features_scene() if step == FEATURES else warm_up_scene(step)
+        RenderSession(scene, threads=1).run()
+        _marker(step).touch()
 
 
 def compile_kernels() -> float:
-    """Compile (or load) every integrator's kernels, the default one first; seconds taken.
+    """Compile (or load) every integrator's kernels, the default one first, and the
+    features'; seconds taken.
 
-    The others are compiled by a second process once this one has put the shader
-    evaluator into the cache."""
+    The other integrators are compiled by a second process once this one has put the
+    shader evaluator into the cache (the longer of the two by about a minute without the
+    features, about 40 s of compiling)."""
     from .packing import pack_scene
     start = time.perf_counter()
-    names = sorted(integrators.NAMES, key=lambda n: n != integrators.DEFAULT)
+    others = sorted(set(integrators.NAMES) - {integrators.DEFAULT})
     helper = None
     try:
-        if len(names) > 1:
-            pack_scene(warm_up_scene())        # compiles the shader evaluator
-            names, others = names[:1], names[1:]
-            helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *others],
-                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
-        _compile(names)
-        if helper is not None and helper.wait() != 0:
+        pack_scene(warm_up_scene())        # compiles the shader evaluator
+        helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *others],
+                                  stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+        _compile([integrators.DEFAULT, FEATURES])
+        if helper.wait() != 0:
             raise RuntimeError(f"compiling the kernels of {', '.join(others)} failed "
                                f"(exit status {helper.returncode})")
     finally:

@@ -1,16 +1,17 @@
-"""The warm-up's scene (mcengine.warmup) runs every kernel of each integrator, so the
-background compile leaves none to be compiled by a user's first render, in a Blender
-process where Cycles may have rendered (numba compiling there crashed it)."""
+"""The warm-up's scenes (mcengine.warmup) run every kernel of each integrator and those a
+scene's features call for, so the background compile leaves none to be compiled by a
+user's first render, in a Blender process where Cycles may have rendered (numba compiling
+there crashed it)."""
 from __future__ import annotations
 
 import functools
 
 import pytest
 
-from mcengine import integrators
-from mcengine.kernels import classic, light_tracing, path, shadows
+from mcengine import background, integrators, packing
+from mcengine.kernels import classic, intersect, light_tracing, motion, path, shadows
 from mcengine.session import RenderSession
-from mcengine.warmup import warm_up_scene
+from mcengine.warmup import features_scene, warm_up_scene
 
 
 def _kernels(module) -> list[str]:
@@ -38,3 +39,20 @@ def test_the_warm_up_render_runs_every_kernel_of_the_integrator(name, monkeypatc
     assert len(expected) >= 4
     RenderSession(warm_up_scene(name), threads=1).run()
     assert called == expected, f"not run: {sorted(expected - called)}"
+
+
+def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):
+    """The world's importance bake, the mesh light's emission estimates, the moving
+    objects' BVH and their intersection kernels: each compiled at a first render that
+    needs it (about 2 minutes in all) if the warm-up did not run it."""
+    called = set()
+    for module, name in ((background, "bake_background"), (packing, "emission_estimates"),
+                         (motion, "build_bvh"), (intersect, "moving_closest"),
+                         (intersect, "moving_occluded")):
+        def record(*args, _fn=getattr(module, name), _key=name):
+            called.add(_key)
+            return _fn(*args)
+        monkeypatch.setattr(module, name, record)
+    RenderSession(features_scene(), threads=1).run()
+    assert called == {"bake_background", "emission_estimates", "build_bvh", "moving_closest",
+                      "moving_occluded"}

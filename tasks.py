@@ -1,7 +1,8 @@
 """Project tasks: set up the environment and run a job in it.
 
     python3.11 tasks.py demo        render blend_scenes/cornell_box.blend with MC Engine and Cycles
-    python3.11 tasks.py test [ARGS] run the test suite (ARGS go to pytest); tests marked slow
+    python3.11 tasks.py test [ARGS] run the test suite (ARGS go to pytest) in two worker
+                                    processes (-n 0: in this one); tests marked slow
                                     (minutes each) only with -m slow, or all with -m ''
     python3.11 tasks.py extension   build the Blender extension zip (dist/extension/)
 
@@ -116,9 +117,14 @@ def run_in_venv(command: list[str]) -> int:
 
 
 def job_test(extra: list[str]) -> int:
-    # The default run (CI's) leaves out the tests marked slow, unless ARGS choose markers.
+    # The default run (CI's) leaves out the tests marked slow, unless ARGS choose markers,
+    # and runs the tests in two worker processes (pytest-xdist), one per core of CI's
+    # machine, each test file in one worker (its module fixtures render once), unless ARGS
+    # choose the workers (-n 0: none).
     markers = [] if any(a == "-m" or a.startswith("-m") for a in extra) else ["-m", "not slow"]
-    return run_in_venv(["python", "-m", "pytest", "-q", *markers, *extra])
+    workers = ([] if any(a.startswith(("-n", "--numprocesses", "--dist")) for a in extra)
+               else ["-n", "2", "--dist", "loadfile"])
+    return run_in_venv(["python", "-m", "pytest", "-q", *markers, *workers, *extra])
 
 
 def job_demo(extra: list[str]) -> int:

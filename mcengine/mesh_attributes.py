@@ -8,6 +8,8 @@ whose shaders read them; the kernel reads them as attributes).
   its neighbours' once (a two-ring blur).
 * :func:`random_per_island` (per triangle): a hash of the representative of the connected
   component (by edges) of the triangle's first vertex, as Cycles' disjoint set finds it.
+* :func:`sphere_uv` (per vertex): the UV map a Normal Map's tangents come from on a mesh
+  without UV maps (Cycles' mikk_compute_tangents with generated coordinates).
 
 Both follow Cycles step by step, in float32 where Cycles' arithmetic shows, so that the
 values agree with Cycles' to float rounding (tests/nodes/test_input_nodes.py).
@@ -18,7 +20,7 @@ import numpy as np
 
 from .kernels.svm.hash import hash_uint, unit
 
-__all__ = ["pointiness", "random_per_island"]
+__all__ = ["pointiness", "random_per_island", "sphere_uv"]
 
 _EPS = np.float32(np.finfo(np.float32).eps)     # FLT_EPSILON
 
@@ -127,3 +129,21 @@ def random_per_island(vertex_count: int, edges: np.ndarray, first_vertices: np.n
     islands, index = np.unique(roots[np.asarray(first_vertices, np.int64)], return_inverse=True)
     values = np.array([unit(hash_uint(int(r))) for r in islands], np.float32)
     return values[index].reshape(-1)
+
+
+def sphere_uv(positions: np.ndarray) -> np.ndarray:
+    """(N, 2) float32: Cycles' map_to_sphere (util/math_float3.h) of (N, 3) object-space
+    positions, the UVs MikkTSpace gets on a mesh without UV maps (Cycles' blender/mesh.cc:
+    the generated coordinates turned back into positions, ``(orco + loc) / size``).  u from
+    the angle about z, 0.5 - atan2(x, y) / 2 pi (0 on the z axis); v from the angle to +z,
+    1 - acos(z / |p|) / pi; (0, 0) at the origin.  The kernels' Image Texture projection
+    applies the same map to the [0, 1] cube (``svm.image_nodes.map_to_sphere``; both agree:
+    tests/core/test_mesh_attributes.py)."""
+    p = np.asarray(positions, np.float64)
+    length = np.sqrt(np.einsum("ij,ij->i", p, p))
+    on_axis = (p[:, 0] == 0.0) & (p[:, 1] == 0.0)
+    u = np.where(on_axis, 0.0, 0.5 - np.arctan2(p[:, 0], p[:, 1]) / (2.0 * np.pi))
+    cos_z = np.clip(p[:, 2] / np.where(length > 0.0, length, 1.0), -1.0, 1.0)
+    uv = np.stack([u, 1.0 - np.arccos(cos_z) / np.pi], axis=1)
+    uv[length == 0.0] = 0.0
+    return uv.astype(np.float32)

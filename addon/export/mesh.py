@@ -28,7 +28,7 @@ import bpy
 import numpy as np
 
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
-from mcengine.mesh_attributes import pointiness, random_per_island
+from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
 from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE, GEOMETRY_ATTRIBUTES
 
@@ -38,6 +38,11 @@ __all__ = ["LocalMesh", "MeshCollector", "read_local_mesh", "transform_instances
 
 # Evaluated object data types Cycles renders but mcengine cannot yet.
 _UNSUPPORTED_DATA = {"CURVES": "hair curves", "POINTCLOUD": "point clouds", "VOLUME": "volume objects"}
+# The note on a mesh without UV maps whose normal maps' tangents come from the sphere
+# mapping (``_add_tangents``) across that mapping's seam, where they were seen to differ from
+# Cycles' (a bumpy grid, tests/nodes/test_normal_nodes.py, 29 % of its pixels; why is not
+# known: the same sphere UVs give Cycles' tangents away from the seam).
+SPHERE_SEAM = "meshes without a UV map across the sphere mapping's seam"
 # Fallback text of each per-object note.
 _OBJECT_NOTES = {
     "hair curves": "these objects are skipped",
@@ -45,8 +50,8 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "holdout/shadow catcher": "these objects render as normal objects",
-    "normal maps without a UV map": "their normal maps leave the normal unchanged (Cycles takes "
-                                    "tangents from generated coordinates there)",
+    SPHERE_SEAM: "their normal maps' tangents near it (object space x = 0, y < 0) may differ "
+                 "from Cycles' (elsewhere they agree)",
 }
 # Object.visible_* flags Cycles uses for meshes.
 _RAYS = ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")
@@ -568,20 +573,25 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
     Cycles runs MikkTSpace on the triangles (``loop_triangles``), with the mesh's shading
     normals (flat faces: each triangle's own normal), so the tangents are those Blender's
     ``Mesh.calc_tangents`` computes for a mesh of those triangles; on a mesh of quads it
-    would pair the triangles differently.  Returns what went wrong, for a note: "" when
-    nothing did, or "normal maps without a UV map" (Cycles then takes tangents from the
-    generated coordinates).  A named map the mesh lacks is left out, as in Cycles (the
-    normal stays unchanged)."""
+    would pair the triangles differently.  The default map of a mesh without UV maps is, as
+    in Cycles (blender/mesh.cpp, mikk_compute_tangents), the generated coordinates mapped to
+    a sphere: ``sphere_uv`` of each vertex's object-space position.  A named map the mesh
+    lacks is left out, as in Cycles (the normal stays unchanged).  Returns what went wrong,
+    for a note: "" or ``SPHERE_SEAM``, a mesh the sphere mapping's seam crosses."""
     layers = {}
     for name in maps:
         layer = default_layer if name == "" else me.uv_layers.get(name)
-        if layer is None:
-            if name == "":
-                return "normal maps without a UV map"
-            continue
-        layers[name] = attributes[layer.name]
+        if layer is not None:
+            layers[name] = attributes[layer.name]
+        elif name == "":
+            layers[name] = CornerTable(sphere_uv(vertices), triangles)
     if not layers:
         return ""
+    note = ""
+    if "" in layers and default_layer is None:
+        u = layers[""].corners(0, len(triangles))[:, :, 0]
+        if np.any(u.max(axis=1) - u.min(axis=1) > 0.5):     # a triangle spans the seam
+            note = SPHERE_SEAM
     t = len(triangles)
     corner_normals = normals.corners(0, t).reshape(-1, 3)
     tm = bpy.data.meshes.new(".mcengine tangents")
@@ -605,7 +615,7 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
             attributes[TANGENT_PREFIX + name] = CornerTable(values, np.arange(3 * t).reshape(t, 3))
     finally:
         bpy.data.meshes.remove(tm)
-    return ""
+    return note
 
 
 def _texspace(ob) -> np.ndarray:

@@ -423,9 +423,24 @@ def test_normal_maps_on_ngons_get_tangents(scene, fake_session):
     assert not any("tangent" in w or "normal map" in w for w in desc.warnings)
 
 
-def test_normal_maps_without_a_uv_map_are_warned(scene, fake_session):
-    ob = new_mesh_object("Bare", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+def test_normal_maps_without_a_uv_map_get_the_tangents_of_the_sphere_mapping(scene, fake_session):
+    """As in Cycles, MikkTSpace runs on the object-space positions mapped to a sphere: u =
+    0.5 - atan2(x, y) / 2 pi grows along (-y, x, 0) (what it renders: test_normal_nodes.py)."""
+    square = [(1, 1, 1), (2, 1, 1), (2, 2, 1), (1, 2, 1)]
+    ob = new_mesh_object("Bare", square, [(0, 1, 2, 3)])
     ob.data.materials.append(_normal_map_material())
     desc = export_scene(fake_session)
-    assert "tangent:" not in desc.geometry.attributes
-    assert any("without a UV map" in w and "Bare" in w for w in desc.warnings)
+    g = desc.geometry
+    tangent = g.attributes["tangent:"].reshape(-1, 4)
+    corners = g.vertices[g.triangles].reshape(-1, 3).astype(np.float64)
+    around_z = np.stack([-corners[:, 1], corners[:, 0], np.zeros(len(corners))], axis=1)
+    around_z /= np.linalg.norm(around_z, axis=1, keepdims=True)
+    np.testing.assert_allclose(np.linalg.norm(tangent[:, :3], axis=1), 1.0, atol=1e-5)
+    assert np.all(np.einsum("ij,ij->i", tangent[:, :3], around_z) > 0.9)
+    assert not any("UV map" in w for w in desc.warnings)
+    # Across the mapping's seam (x = 0, y < 0), where Cycles' tangents were seen to differ.
+    across = new_mesh_object("Across", [(-1, -2, 1), (1, -2, 1), (1, -1, 1), (-1, -1, 1)],
+                             [(0, 1, 2, 3)])
+    across.data.materials.append(_normal_map_material())
+    warnings = [w for w in export_scene(fake_session).warnings if "seam" in w]
+    assert len(warnings) == 1 and "'Across'" in warnings[0] and "'Bare'" not in warnings[0]

@@ -1,7 +1,7 @@
-"""Pointiness and Random Per Island (``mcengine.mesh_attributes``): closed forms on a cube
-and a flat grid, and agreement with a vertex-by-vertex transcription of Cycles' loops on
-meshes with doubled and nearly doubled vertices (the Blender side is checked against Cycles
-itself in tests/nodes/test_input_nodes.py)."""
+"""Pointiness, Random Per Island and the sphere UVs (``mcengine.mesh_attributes``): closed
+forms on a cube and a flat grid, and agreement with a vertex-by-vertex transcription of
+Cycles' loops on meshes with doubled and nearly doubled vertices (the Blender side is
+checked against Cycles itself in tests/nodes/test_input_nodes.py and test_normal_nodes.py)."""
 from __future__ import annotations
 
 import math
@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from mcengine.kernels.svm.hash import hash_uint, unit
-from mcengine.mesh_attributes import pointiness, random_per_island
+from mcengine.kernels.svm.image_nodes import map_to_sphere
+from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
 
 FLT_EPSILON = float(np.finfo(np.float32).eps)
 CUBE = np.array([(x, y, z) for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
@@ -172,3 +173,16 @@ def test_a_double_is_found_past_other_vertices_of_the_same_coordinate_sum():
     got = pointiness(positions, normals, edges)
     np.testing.assert_allclose(got, _cycles_pointiness(positions, normals, edges), atol=2e-6)
     assert got[0] == got[2]
+
+
+def test_sphere_uvs_have_the_closed_form_and_match_the_kernels_projection():
+    """u = 0.5 - atan2(x, y) / 2 pi, v = 1 - acos(z / |p|) / pi (Cycles' map_to_sphere): the
+    poles, the equator's quarters, the origin; and on random points what the Image Texture
+    node's sphere projection gives for the same point of its [0, 1] cube."""
+    points = np.array([(0, 0, 2), (0, 0, -1), (0, 1, 0), (1, 0, 0), (0, -1, 0), (-1, 0, 0), (0, 0, 0)])
+    np.testing.assert_allclose(sphere_uv(points), [(0, 1), (0, 0), (0.5, 0.5), (0.25, 0.5),
+                                                   (0, 0.5), (0.75, 0.5), (0, 0)], atol=1e-7)
+    rng = np.random.default_rng(4)
+    p = rng.normal(size=(200, 3))
+    kernel = np.array([map_to_sphere(*(0.5 * q + 0.5)) for q in p])
+    np.testing.assert_allclose(sphere_uv(p), kernel, rtol=1e-6, atol=1e-6)

@@ -4,6 +4,9 @@ Tangent space reads the MikkTSpace tangents of a UV map (Blender's calc_tangents
 the interpolated vertex normals in object space; the cases turn, scale and mirror the
 plane, curve it (smooth shading over a bumpy grid), show its back face, use a second UV
 map, vary the colour across the plane with a checker, and cover every space and strength.
+Without a UV map, the tangents come from the object-space positions mapped to a sphere,
+as in Cycles (away from that mapping's seam, x = 0, y < 0: across it they were seen to
+differ, and the export warns).
 """
 import math
 
@@ -80,6 +83,24 @@ def _bumpy(ob):
     ob.rotation_euler = (0.2, 0.1, 0.0)
 
 
+def _without_uv(ob):
+    """No UV map, and the plane off its object's origin (its object moved back, so it is seen
+    where it was): the sphere mapping of the positions varies over it, and its seam stays
+    clear of it."""
+    from mathutils import Matrix
+
+    me = ob.data
+    while me.uv_layers:
+        me.uv_layers.remove(me.uv_layers[0])
+    me.transform(Matrix.Translation((0.2, 0.9, 0.4)))
+    ob.location = (ob.location.x - 0.2, ob.location.y - 0.9, ob.location.z - 0.4)
+
+
+def _bumpy_without_uv(ob):
+    _bumpy(ob)
+    _without_uv(ob)
+
+
 CASES = {
     "tangent": _normal_map(),
     "tangent strength 0.5": _normal_map(strength=0.5),
@@ -94,6 +115,8 @@ CASES = {
     "tangent bumpy smooth": (_normal_map(), _bumpy),
     "tangent bumpy checker": (_normal_map(checker=True, strength=1.5), _bumpy),
     "tangent missing uv map": _normal_map(uv_map="Nothing"),
+    "tangent without uv maps": (_normal_map(), _without_uv),
+    "tangent bumpy without uv maps": (_normal_map(checker=True, strength=1.5), _bumpy_without_uv),
     **{f"{space.lower()} {label}": (_normal_map(space=space, strength=s), prep)
        for space in ("OBJECT", "WORLD", "BLENDER_OBJECT", "BLENDER_WORLD")
        for label, s, prep in (("rotated", 1.0, _rotated), ("strength 0.5", 0.5, _rotated),

@@ -50,6 +50,9 @@ from .scene import (
 __all__ = ["warm_up_scene", "features_scene", "compile_kernels", "is_compiled", "main"]
 
 FEATURES = "features"      # the warm-up step that renders ``features_scene``
+# The floor of both scenes: a 2 m square at z = 0 facing up, two triangles.
+_FLOOR = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
+                  np.float64)
 
 
 def _marker(integrator: str):
@@ -70,9 +73,7 @@ def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
     so is compiled (``tests/core/test_warm_up_scene.py``): the lamp and the mirrors make
     Path + Light Tracing trace light paths (``kernels.light_tracing.prepare``), and of its
     64 light paths many reach the floor from the ceiling's mirror and join the camera."""
-    floor = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
-                     np.float64)
-    ceiling = floor[:, ::-1] + (0.0, 0.0, 2.5)       # facing down
+    ceiling = _FLOOR[:, ::-1] + (0.0, 0.0, 2.5)       # facing down
     camera = np.eye(4)
     camera[2, 3] = 2.2
     lamp = np.eye(4)
@@ -80,7 +81,7 @@ def warm_up_scene(integrator: str = integrators.DEFAULT) -> SceneDescription:
     samples = 64 if integrators.get(integrator).light_tracing else 1
     return SceneDescription(
         denoising=Denoising(enabled=True),     # the denoiser's guide passes (not the denoiser)
-        geometry=Geometry.from_triangles(np.concatenate([floor, ceiling])),
+        geometry=Geometry.from_triangles(np.concatenate([_FLOOR, ceiling])),
         materials=[_warm_up_material()],
         lights=[Light(type="POINT", matrix_world=lamp, radius=0.0)],
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
@@ -103,9 +104,7 @@ def features_scene() -> SceneDescription:
     emits a gradient (a mesh light whose emission varies: ``kernels.shading.emission_estimates``
     weighs it) and moves while the shutter is open (motion blur: ``kernels.motion``), above
     the warm-up's floor."""
-    floor = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
-                     np.float64)
-    lamp = floor[:, ::-1] * 0.2 + (0.0, 0.0, 1.0)         # facing down
+    lamp = _FLOOR[:, ::-1] * 0.2 + (0.0, 0.0, 1.0)         # facing down
     gradient = [ShaderNode("TexGradient")]
     emission = Material(name="lamp", nodes=gradient + [ShaderNode("Emission", {"Color": Link(0, "Color")})],
                         surface=Link(1, "Emission"))
@@ -116,7 +115,7 @@ def features_scene() -> SceneDescription:
     camera = np.eye(4)
     camera[2, 3] = 0.5
     return SceneDescription(
-        geometry=Geometry.from_triangles(np.concatenate([floor, lamp]), material_index=[0, 0, 1, 1],
+        geometry=Geometry.from_triangles(np.concatenate([_FLOOR, lamp]), material_index=[0, 0, 1, 1],
                                          object_index=[0, 0, 1, 1], object_names=["floor", "lamp"]),
         materials=[Material(), emission], world=world,
         motion_blur=MotionBlur(objects=[ObjectMotion(object=1, vertices=(6, 6), matrices=steps)]),

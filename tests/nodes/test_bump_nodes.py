@@ -318,7 +318,8 @@ def test_shadow_terminator_offset_agrees_with_cycles(lit_spheres, kind):
     each object's offsets, the last three spheres rendered as the first."""
     k = TERMINATOR_SPHERES.index(kind)
     ref, ours = (img[48 * k:48 * (k + 1)] for img in lit_spheres)
-    assert (ref.max(axis=2) > 0.05).mean() > 0.03         # the lit side is in view
+    # The lit side is in view (Shading Offset 1 lights only within 45 deg of the sun).
+    assert (ref.max(axis=2) > 0.05).mean() > (0.03 if kind == "shading offset 1" else 0.1)
     if "offset" in kind:               # Cycles renders the setting: not the default sphere
         assert np.abs(ref - lit_spheres[0][:48]).max() > 0.01
     assert_agree(kind, ref, ours, rel=1e-3, abs_tol=1e-4, edge_fraction=0.0)

@@ -31,7 +31,6 @@ __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node"
 DEFAULT_GREY = (0.8, 0.8, 0.8)
 DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
 BLACK = (0.0, 0.0, 0.0)
-_THIN_FILM_CUTOFF = 0.1
 
 
 class MaterialTable:
@@ -160,9 +159,6 @@ class _MaterialGraph(GraphReader):
     def _check(self, node, kind, inputs) -> None:
         """Note what the closure model renders differently from Cycles."""
         lbl = label(node)
-        thin = inputs.get("Thin Film Thickness", 0.0)
-        if isinstance(thin, Link) or thin > _THIN_FILM_CUTOFF:
-            self.note(f"{lbl} thin film", "thin film", "thin-film interference ignored")
         sss = inputs.get("Subsurface Weight", 0.0)
         if kind == "BsdfPrincipled" and (isinstance(sss, Link) or sss > 0.0):
             self.note(f"{lbl} subsurface weight {fmt(sss) if not isinstance(sss, Link) else '(linked)'}",

@@ -198,10 +198,13 @@ def test_metallic_node_is_copied_with_its_fresnel_type(scene, fake_session, fres
 
 def test_what_is_rendered_differently_is_warned_once(scene, fake_session):
     mat = principled("Skin", Subsurface_Weight=0.5, Thin_Film_Thickness=300.0)
-    _, warnings = exported(fake_session, mat)
+    out, warnings = exported(fake_session, mat)
     assert len(warnings) == 1
-    for part in ("thin film", "subsurface weight 0.5", "subsurface rendered as diffuse"):
+    for part in ("subsurface weight 0.5", "subsurface rendered as diffuse"):
         assert part in warnings[0]
+    assert "thin film" not in warnings[0]         # rendered as Cycles does
+    node = surface(out)
+    assert node.inputs["Thin Film Thickness"] == 300.0 and node.inputs["Thin Film IOR"] == pytest.approx(1.33)
 
 
 @pytest.mark.parametrize("bl_idname,anisotropy", [("ShaderNodeBsdfPrincipled", "Anisotropic"),

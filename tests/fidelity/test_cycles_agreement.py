@@ -44,8 +44,8 @@ def test_scenes_exist():
             # textured scenes of issue 10
             "texture_checker_lights", "attribute_vertex_colors", "texture_suzanne_maps",
             "world_hdri_interior",
-            # the tangents of anisotropic closures
-            "material_anisotropic"} <= names
+            # the tangents of anisotropic closures; thin-film interference
+            "material_anisotropic", "material_thin_film"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

@@ -88,6 +88,23 @@ def test_missing_bump_shadowing_is_caught(renders):
     assert np.all(a.frame_rejected) and np.all(a.frame_rel_bias > 0)
 
 
+def _without_thin_films(scene):
+    for material in bpy.data.materials:
+        for node in material.node_tree.nodes if material.node_tree else ():
+            if "Thin Film Thickness" in node.inputs:
+                node.inputs["Thin Film Thickness"].default_value = 0.0
+
+
+def test_ignored_thin_films_are_caught(renders):
+    """Films left out (what MC Engine rendered before it had thin films): the spheres'
+    colours are the film-free Fresnel's, which Cycles' 4x4 block means put up to 20 % of
+    the frame mean away; several blocks of each sign differ."""
+    result = renders.compare("material_thin_film", "no thin films", _without_thin_films)
+    assert result.verdict == "differ"
+    differing = result.agreement.differing_blocks()
+    assert any(d["t"] > 0 for d in differing) and any(d["t"] < 0 for d in differing), differing
+
+
 def _unlinked(material, socket_owner, socket):
     def edit(scene):
         tree = bpy.data.materials[material].node_tree

@@ -50,7 +50,9 @@ CL_ALBEDO = 36           # 3: microfacet: the albedo estimate at the view, from 
 CL_NS = 39               # 3: the point's smooth (interpolated, not normal-mapped) normal, viewer's side
 CL_BUMP_CORRECTION = 42  # 1: the material's Bump Map Correction is on (softens diffuse closures)
 CL_TERMINATOR = 43       # the object's Shadow Terminator Shading Offset as a frequency (> 1: on)
-CL_STRIDE = 44
+CL_FILM_THICKNESS = 44   # microfacet: thin film over the surface, thickness in nm (<= 0.1: none)
+CL_FILM_IOR = 45         # microfacet: the film's IOR relative to the outside (tf / IOR on back faces)
+CL_STRIDE = 46
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0

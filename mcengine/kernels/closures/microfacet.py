@@ -4,8 +4,9 @@ Rows of type CT_MICROFACET (reflection only), CT_MICROFACET_REFRACTION (refracti
 and CT_MICROFACET_GLASS (both, split by Fresnel) read these columns (``layout``): CL_AX,
 CL_AY (alpha along the frame's +x and +y), CL_ETA (inside / outside, already inverted on
 back faces), CL_DIST (MD_GGX or MD_BECKMANN), CL_FRESNEL and its parameters (CL_F0, CL_F90,
-CL_EXPONENT, CL_RTINT, CL_TTINT) and CL_ENERGY (the multiple-scattering scale, applied to
-GGX only, as Cycles does).
+CL_EXPONENT, CL_RTINT, CL_TTINT), a thin film over the surface (CL_FILM_THICKNESS,
+CL_FILM_IOR: ``thin_film``) and CL_ENERGY (the multiple-scattering scale, applied to GGX
+only, as Cycles does).
 
 The model (Walter et al. 2007; Heitz 2014) with Cycles' choices:
 
@@ -58,6 +59,8 @@ from .layout import (
     CL_EXPONENT,
     CL_F0,
     CL_F90,
+    CL_FILM_IOR,
+    CL_FILM_THICKNESS,
     CL_FRESNEL,
     CL_RTINT,
     CL_SW,
@@ -70,6 +73,7 @@ from .layout import (
     FR_CONDUCTOR,
     FR_DIELECTRIC,
     FR_F82,
+    FR_NONE,
     FR_SCHLICK,
     LABEL_GLOSSY,
     LABEL_NONE,
@@ -90,6 +94,12 @@ from .tables import (
     GGX_GLASS_INV_EAVG,
     lookup_2d,
     lookup_3d,
+)
+from .thin_film import (
+    THIN_FILM_CUTOFF,
+    f82_conductor_ior,
+    iridescence_conductor,
+    schlick_iridescence,
 )
 
 # ``function`` (called, not inlined): the Beckmann sampler (and its erfinv) costs about 0.5 us,
@@ -341,6 +351,10 @@ def microfacet_fresnel(cl, k, cos_hi):
       reflection gives R = CL_RTINT, T = 0;
     * FR_F82: R = F82(F0 = CL_F0, B = CL_F90), T = 0;
     * FR_CONDUCTOR: R = the conductor Fresnel of n = CL_F0, k = CL_F90, T = 0.
+
+    With a thin film (CL_FILM_THICKNESS above THIN_FILM_CUTOFF) FR_SCHLICK (exponent < 0,
+    what every node uses), FR_F82 and FR_CONDUCTOR take the film's reflectance instead
+    (``thin_film``; F82: on the n + ik estimated from F0 and F82).
     """
     ctype = int(cl[k, CL_TYPE])
     has_r = 1.0 if ctype != CT_MICROFACET_REFRACTION else 0.0
@@ -349,6 +363,9 @@ def microfacet_fresnel(cl, k, cos_hi):
     eta = cl[k, CL_ETA]
     # the exact dielectric Fresnel, computed once (cheap) and used by three of the models
     f_real, cos_t = fresnel_dielectric(cos_hi, eta)
+    film = cl[k, CL_FILM_THICKNESS]
+    if film > THIN_FILM_CUTOFF and model != FR_DIELECTRIC and model != FR_NONE:
+        return _film_fresnel(cl, k, cos_hi, film, model, eta, cos_t, has_r, has_t)
     if model == FR_DIELECTRIC:
         rr = rg = rb = f_real
         tr = tg = tb = 1.0 - f_real
@@ -392,6 +409,36 @@ def microfacet_fresnel(cl, k, cos_hi):
         rr = rg = rb = 1.0
         tr = tg = tb = 1.0 if f_real < 1.0 else 0.0      # no transmission under TIR
     return (rr * has_r, rg * has_r, rb * has_r, tr * has_t, tg * has_t, tb * has_t, cos_t)
+
+
+@function
+def _film_fresnel(cl, k, cos_hi, film, model, eta, cos_t, has_r, has_t):
+    """``microfacet_fresnel`` of a row under a thin film (called: a rare, long path)."""
+    film_ior = cl[k, CL_FILM_IOR]
+    c = abs(cos_hi)
+    if model == FR_SCHLICK:
+        fr, fg, fb = schlick_iridescence(c, film, film_ior, eta,
+                                         cl[k, CL_F0], cl[k, CL_F0 + 1], cl[k, CL_F0 + 2])
+        return (fr * cl[k, CL_RTINT] * has_r, fg * cl[k, CL_RTINT + 1] * has_r,
+                fb * cl[k, CL_RTINT + 2] * has_r, (1.0 - fr) * cl[k, CL_TTINT] * has_t,
+                (1.0 - fg) * cl[k, CL_TTINT + 1] * has_t, (1.0 - fb) * cl[k, CL_TTINT + 2] * has_t,
+                cos_t)
+    rr = rg = rb = 0.0
+    for ch in range(3):
+        if model == FR_F82:
+            f0 = cl[k, CL_F0 + ch]
+            f82 = fresnel_f82(1.0 / 7.0, f0, cl[k, CL_F90 + ch])
+            n, kk = f82_conductor_ior(f0, f82)
+        else:
+            n, kk, f82 = cl[k, CL_F0 + ch], cl[k, CL_F90 + ch], -1.0
+        v = iridescence_conductor(ch, c, film, film_ior, n, kk, f82)
+        if ch == 0:
+            rr = v
+        elif ch == 1:
+            rg = v
+        else:
+            rb = v
+    return rr * has_r, rg * has_r, rb * has_r, 0.0, 0.0, 0.0, cos_t
 
 
 @device
@@ -586,7 +633,8 @@ def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
     GGX_GEN_SCHLICK_S at z = 0.5, B ignored) and FR_DIELECTRIC with eta > 1
     (mix(F0(eta), 1, s) from GGX_GEN_SCHLICK_IOR_S), all read at r = (ax ay)^(1/4),
     whatever the distribution.  Transmission is always the smooth (1 - F) x tint (and the
-    conductor's reflection the smooth Fresnel: Cycles has no table for it).
+    conductor's reflection, and any reflection under a thin film, the smooth Fresnel:
+    Cycles has no table for them).
     """
     rr, rg, rb, tr, tg, tb, _ = microfacet_fresnel(cl, k, cos_no)
     if not with_reflection:
@@ -597,6 +645,8 @@ def microfacet_albedo(cl, k, cos_no, with_reflection, with_transmission):
         return tr, tg, tb
     model = int(cl[k, CL_FRESNEL])
     eta = cl[k, CL_ETA]
+    if cl[k, CL_FILM_THICKNESS] > THIN_FILM_CUTOFF and model != FR_DIELECTRIC:
+        return rr + tr, rg + tg, rb + tb
     if model == FR_SCHLICK:
         e = cl[k, CL_EXPONENT]
         table = GGX_GEN_SCHLICK_IOR_S if e < 0.0 else GGX_GEN_SCHLICK_S

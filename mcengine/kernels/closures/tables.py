@@ -28,6 +28,14 @@ them (as constants, stored in the on-disk cache too), so a kernel never receives
 arguments.  A missing data file (before ``tools/make_bsdf_tables.py`` has run) leaves that
 table filled with NaN and ``TABLES_LOADED`` False.
 
+The thin-film table (Belcour and Barla's Fourier-transformed colour matching functions) is
+not an integral of a closure: ``tools/make_thin_film_table.py`` writes the transform of the
+CIE 1931 XYZ CMFs to ``data/thin_film_cmf.npy``, and here, as Cycles'
+``ShaderManager::compute_thin_film_table`` does at scene load, each entry is turned into the
+working space's RGB (``kernels.colorspace.XYZ_TO_RGB``) and divided by the channel's value at
+optical path difference 0: ``THIN_FILM_RE`` and ``THIN_FILM_IM``, shape (3, 512), RGB rows,
+read with ``lookup_row`` at x = 2 pi OPD / 60000 nm.
+
 ``lookup_1d/2d/3d`` reproduce Cycles' kernel/util/lookup_table.h: each coordinate is
 clamped to [0, 1] (NaN reads as 0), scaled to [0, n - 1], and the table is interpolated
 linearly between the two nearest nodes along each axis (multilinear).
@@ -39,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from ...jit import device
+from ..colorspace import XYZ_TO_RGB
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
 
@@ -53,11 +62,12 @@ TABLE_SHAPES = {
     "ggx_gen_schlick_ior_s": (16, 16, 16),
     "ggx_gen_schlick_s": (16, 16, 16),
 }
+THIN_FILM_SHAPE = (2, 3, 512)     # real and imaginary parts of X, Y, Z at 512 path differences
 
 
-def _load(name: str) -> tuple[np.ndarray, bool]:
+def _load(name: str, shape: tuple[int, ...] | None = None) -> tuple[np.ndarray, bool]:
     path = DATA_DIR / f"{name}.npy"
-    shape = TABLE_SHAPES[name]
+    shape = shape or TABLE_SHAPES[name]
     if not path.exists():
         return np.full(shape, np.nan), False
     table = np.ascontiguousarray(np.load(path), dtype=np.float64)
@@ -74,7 +84,11 @@ GGX_GLASS_INV_E, _ok4 = _load("ggx_glass_inv_E")
 GGX_GLASS_INV_EAVG, _ok5 = _load("ggx_glass_inv_Eavg")
 GGX_GEN_SCHLICK_IOR_S, _ok6 = _load("ggx_gen_schlick_ior_s")
 GGX_GEN_SCHLICK_S, _ok7 = _load("ggx_gen_schlick_s")
-TABLES_LOADED = all((_ok0, _ok1, _ok2, _ok3, _ok4, _ok5, _ok6, _ok7))
+_THIN_FILM_XYZ, _ok8 = _load("thin_film_cmf", THIN_FILM_SHAPE)
+TABLES_LOADED = all((_ok0, _ok1, _ok2, _ok3, _ok4, _ok5, _ok6, _ok7, _ok8))
+_thin_film_rgb = np.einsum("rx,pxj->prj", XYZ_TO_RGB, _THIN_FILM_XYZ)
+THIN_FILM_RE = np.ascontiguousarray(_thin_film_rgb[0] / _thin_film_rgb[0, :, :1])
+THIN_FILM_IM = np.ascontiguousarray(_thin_film_rgb[1] / _thin_film_rgb[0, :, :1])
 # GGX_E and GGX_EAVG with a leading axis of one node, so that a single lookup_3d / lookup_2d
 # site reads either them (z = 0) or the glass tables.
 GGX_E_3D = np.ascontiguousarray(GGX_E[None])
@@ -100,6 +114,15 @@ def lookup_1d(table, x):
     if t == 0.0:
         return table[i]
     return (1.0 - t) * table[i] + t * table[j]
+
+
+@device
+def lookup_row(table, row, x):
+    """table[row, x] for a 2-D table, linear along its last axis, x clamped to [0, 1]."""
+    i, t, j = _axis(x, table.shape[1])
+    if t == 0.0:
+        return table[row, i]
+    return (1.0 - t) * table[row, i] + t * table[row, j]
 
 
 @device

@@ -41,10 +41,10 @@ from collections import namedtuple
 import numpy as np
 
 from ...jit import device, function
+from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .bump import bump_point, with_normal
 from .closure_nodes import eval_closure_node
 from .color_nodes import eval_color_node
-from .colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ATTR_DEFAULT_UV,
     IMG_STRIDE,

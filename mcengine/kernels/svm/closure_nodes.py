@@ -33,6 +33,8 @@ from ..closures.layout import (
     CL_EXPONENT,
     CL_F0,
     CL_F90,
+    CL_FILM_IOR,
+    CL_FILM_THICKNESS,
     CL_FRESNEL,
     CL_N,
     CL_NS,
@@ -58,6 +60,7 @@ from ..closures.layout import (
     MD_GGX,
 )
 from ..closures.sheen import sheen_setup
+from ..closures.thin_film import THIN_FILM_CUTOFF
 from ..sampling import orthonormal_basis
 from .nodes import (
     COLOR_IN,
@@ -77,6 +80,8 @@ from .nodes import (
     GL_IOR,
     GL_NORMAL,
     GL_ROUGHNESS,
+    GL_THIN_FILM,
+    GL_THIN_FILM_IOR,
     K_BACKGROUND,
     K_DIFFUSE,
     K_EMISSION,
@@ -100,6 +105,8 @@ from .nodes import (
     M_ROTATION,
     M_ROUGHNESS,
     M_TANGENT,
+    M_THIN_FILM,
+    M_THIN_FILM_IOR,
     P_ALPHA,
     P_ANISOTROPIC,
     P_ANISOTROPIC_ROTATION,
@@ -125,6 +132,7 @@ from .nodes import (
     P_SUBSURFACE_WEIGHT,
     P_TANGENT,
     P_THIN_FILM,
+    P_THIN_FILM_IOR,
     P_TRANSMISSION,
     R_DISTRIBUTION,
     R_IOR,
@@ -134,8 +142,6 @@ from .nodes import (
     S_ROUGHNESS,
     TL_NORMAL,
 )
-
-THIN_FILM_CUTOFF = 0.1     # nm: thinner films are absent (Cycles' THINFILM_THICKNESS_CUTOFF)
 
 
 @device
@@ -292,6 +298,13 @@ def schlick(cl, k, cos_no, f0r, f0g, f0b, exponent, rtr, rtg, rtb, ttr, ttg, ttb
     cl[k, CL_RTINT], cl[k, CL_RTINT + 1], cl[k, CL_RTINT + 2] = rtr, rtg, rtb
     cl[k, CL_TTINT], cl[k, CL_TTINT + 1], cl[k, CL_TTINT + 2] = ttr, ttg, ttb
     microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy)
+
+
+@device
+def set_film(cl, k, thickness, ior):
+    """A thin film over closure k: thickness in nm, IOR relative to the outside."""
+    cl[k, CL_FILM_THICKNESS] = thickness
+    cl[k, CL_FILM_IOR] = ior
 
 
 @device
@@ -480,6 +493,7 @@ def metallic(regs, b, w, cl, n, sd):
         tx = ty = tz = 0.0
     dist = regs[b + M_DISTRIBUTION]
     cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, 1.0, nx, ny, nz, tx, ty, tz, sd)
+    set_film(cl, k, max(regs[b + M_THIN_FILM], 1e-5), max(regs[b + M_THIN_FILM_IOR], 1e-5))
     multiscatter = dist == DIST_MULTI_GGX
     if regs[b + M_FRESNEL] == FRESNEL_PHYSICAL_CONDUCTOR:
         for c in range(3):
@@ -512,6 +526,8 @@ def glass(regs, b, w, cl, n, sd):
     dist = regs[b + GL_DISTRIBUTION]
     cos_no = microfacet(cl, k, CT_MICROFACET_GLASS, dist, a, a, 1.0 / ior if sd.backfacing else ior,
                         nx, ny, nz, 0.0, 0.0, 0.0, sd)
+    film_ior = max(regs[b + GL_THIN_FILM_IOR], 1e-5)
+    set_film(cl, k, regs[b + GL_THIN_FILM], film_ior / ior if sd.backfacing else film_ior)
     cr, cg, cb = max(regs[b + COLOR_IN], 0.0), max(regs[b + COLOR_IN + 1], 0.0), max(regs[b + COLOR_IN + 2], 0.0)
     f0 = F0_from_ior(ior)
     schlick(cl, k, cos_no, f0, f0, f0, -ior,
@@ -551,6 +567,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
                         regs[b + P_EMISSION_COLOR + 2] * es)
     anisotropic = sat(regs[b + P_ANISOTROPIC])
     thin_film = regs[b + P_THIN_FILM]
+    film_ior = max(regs[b + P_THIN_FILM_IOR], 1e-5) if thin_film > THIN_FILM_CUTOFF else 0.0
     subsurface = sat(regs[b + P_SUBSURFACE_WEIGHT])
     coat_weight = max(regs[b + P_COAT_WEIGHT], 0.0)
     sheen_weight = max(regs[b + P_SHEEN_WEIGHT], 0.0)
@@ -628,6 +645,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
                 cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, 1.0, rnx, rny, rnz,
                                     tx, ty, tz, sd)
                 cl[k, CL_F0], cl[k, CL_F0 + 1], cl[k, CL_F0 + 2] = cbase_r, cbase_g, cbase_b
+                set_film(cl, k, thin_film, film_ior)
                 microfacet_setup_fresnel_f82_tint(cl, k, cos_no, min(st_r, 1.0), min(st_g, 1.0),
                                                   min(st_b, 1.0), multiscatter)
         wr, wg, wb = wr * (1.0 - metallic), wg * (1.0 - metallic), wb * (1.0 - metallic)
@@ -641,6 +659,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
                 cos_no = microfacet(cl, k, CT_MICROFACET_GLASS, dist, a, a,
                                     1.0 / ior if sd.backfacing else ior, rnx, rny, rnz,
                                     0.0, 0.0, 0.0, sd)
+                set_film(cl, k, thin_film, film_ior / ior if sd.backfacing else film_ior)
                 f0 = F0_from_ior(ior)
                 t_r = math.sqrt(cbase_r) if refr else 0.0
                 t_g = math.sqrt(cbase_g) if refr else 0.0
@@ -662,6 +681,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
         k, n = alloc(cl, n, wr, wg, wb, sd)
         if k >= 0:
             cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, eta, rnx, rny, rnz, tx, ty, tz, sd)
+            set_film(cl, k, thin_film, film_ior)
             schlick(cl, k, cos_no, f0 * st_r, f0 * st_g, f0 * st_b, -eta, 1.0, 1.0, 1.0,
                     0.0, 0.0, 0.0, multiscatter)
             wr, wg, wb = layer_weight(cl, k, wr, wg, wb)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
-from .colorspace import hsv_to_rgb, rgb_to_hsv
+from ..colorspace import hsv_to_rgb, rgb_to_hsv
 from .nodes import (
     DATA_FLOAT,
     DATA_VECTOR,

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from ...jit import device, function
-from .colorspace import blackbody, hsl_to_rgb, hsv_to_rgb, luminance, rgb_to_hsl, rgb_to_hsv, wavelength
+from ..colorspace import blackbody, hsl_to_rgb, hsv_to_rgb, luminance, rgb_to_hsl, rgb_to_hsv, wavelength
 from .nodes import (
     CLAMP_TYPES,
     COLOR_MODES,

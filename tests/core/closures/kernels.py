@@ -28,6 +28,8 @@ from mcengine.kernels.closures.layout import (
     CL_EXPONENT,
     CL_F0,
     CL_F90,
+    CL_FILM_IOR,
+    CL_FILM_THICKNESS,
     CL_FRESNEL,
     CL_N,
     CL_RTINT,
@@ -75,7 +77,8 @@ def oren_nayar_row(sigma: float, color=(1.0, 1.0, 1.0), cos_no: float = 1.0) -> 
 def microfacet_row(ctype: int = CT_MICROFACET, dist: int = MD_GGX, alpha: float = 0.25,
                    alpha_y: float | None = None, eta: float = 1.5, fresnel: int = FR_NONE,
                    f0=(0.04, 0.04, 0.04), f90=(1.0, 1.0, 1.0), exponent: float = -1.0,
-                   rtint=(1.0, 1.0, 1.0), ttint=(1.0, 1.0, 1.0), energy: float = 1.0) -> np.ndarray:
+                   rtint=(1.0, 1.0, 1.0), ttint=(1.0, 1.0, 1.0), energy: float = 1.0,
+                   film=(0.0, 1.0)) -> np.ndarray:
     cl = empty_row(ctype)
     cl[0, CL_DIST] = dist
     cl[0, CL_AX] = alpha
@@ -88,6 +91,7 @@ def microfacet_row(ctype: int = CT_MICROFACET, dist: int = MD_GGX, alpha: float 
     cl[0, CL_RTINT:CL_RTINT + 3] = rtint
     cl[0, CL_TTINT:CL_TTINT + 3] = ttint
     cl[0, CL_ENERGY] = energy
+    cl[0, CL_FILM_THICKNESS], cl[0, CL_FILM_IOR] = film
     return cl
 
 

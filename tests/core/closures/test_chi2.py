@@ -1,8 +1,9 @@
 """Chi-square goodness of fit of every closure sampler against the pdf its eval returns.
 
-114 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
+120 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
 overall): Lambert, translucent and Oren-Nayar; GGX and Beckmann reflection, refraction and
-glass at eta 1.5 and 1/1.5; anisotropic GGX; views at 0, 45 and 89 degrees; roughness
+glass at eta 1.5 and 1/1.5; anisotropic GGX; GGX glass under a 400 nm thin film (coloured
+reflectance: the lobe is picked by its average); views at 0, 45 and 89 degrees; roughness
 0.05, 0.3 and 1 (alpha = roughness^2).  2^18 samples each, numpy Generator seeds fixed.
 A representative subset runs by default, the whole grid with ``-m slow``.
 
@@ -33,6 +34,7 @@ from mcengine.kernels.closures.layout import (
     CT_TRANSLUCENT,
     FR_DIELECTRIC,
     FR_NONE,
+    FR_SCHLICK,
     MD_BECKMANN,
     MD_GGX,
 )
@@ -90,6 +92,14 @@ def _case_list():
             for phi in (0.0, 60.0):
                 cases.append((f"ggx-aniso-r{r}", dict(ctype=CT_MICROFACET, dist=MD_GGX, alpha=a * 0.5,
                                                       alpha_y=a / 0.5), theta, phi))
+    # GGX glass under a thin film (the Glass node's Thin Film Thickness 400, IOR 1.33)
+    for eta in (1.5, 1.0 / 1.5):
+        for theta in THETAS:
+            f0 = ((eta - 1.0) / (eta + 1.0)) ** 2
+            cases.append((f"ggx-film-glass-r0.3-eta{eta:.3f}",
+                          dict(ctype=CT_MICROFACET_GLASS, dist=MD_GGX, alpha=0.09, eta=eta,
+                               fresnel=FR_SCHLICK, f0=(f0, f0, f0), exponent=-1.5,
+                               film=(400.0, 1.33 if eta > 1.0 else 1.33 * eta)), theta, 0.0))
     return cases
 
 

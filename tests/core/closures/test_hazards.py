@@ -1,5 +1,6 @@
 """Numerical hazards: roughness 0 and 1, views down to cos 1e-7, IOR 1, below 1 and 10,
-grazing total internal reflection, uniforms at 0 and 1.  No NaN, no Inf, nothing negative,
+grazing total internal reflection, uniforms at 0 and 1, thin films from the cutoff to 20 um
+with film IORs from 1e-5 to 10.  No NaN, no Inf, nothing negative,
 no sample weight above 1 for white lobes (so no albedo above 1)."""
 from __future__ import annotations
 
@@ -43,6 +44,8 @@ kinds = st.sampled_from([
     (CT_MICROFACET_REFRACTION, FR_NONE), (CT_MICROFACET_GLASS, FR_DIELECTRIC), (CT_MICROFACET_GLASS, FR_SCHLICK),
 ])
 WHITE = (FR_NONE, FR_DIELECTRIC)
+films = st.sampled_from([(0.0, 1.0), (0.1001, 1.33), (0.5, 1.33), (300.0, 1e-5), (450.0, 1.33),
+                         (2e4, 10.0)])
 
 
 def _view(cos_t, phi):
@@ -76,16 +79,17 @@ def _check(cl, wo, u, white):
 @settings(max_examples=200, deadline=None)
 @given(kind=kinds, dist=st.sampled_from([MD_GGX, MD_BECKMANN]), r=roughness, r2=roughness, eta=etas,
        cos_t=cosines, phi=st.floats(0.0, 2 * math.pi), u1=uniforms, u2=uniforms, u3=uniforms,
-       f0=st.floats(0.0, 1.0), b=st.floats(-1.0, 2.0), exponent=st.one_of(st.just(-1.0), st.floats(0.0, 1e4)))
+       f0=st.floats(0.0, 1.0), b=st.floats(-1.0, 2.0), exponent=st.one_of(st.just(-1.0), st.floats(0.0, 1e4)),
+       film=films)
 @example(kind=(CT_MICROFACET_GLASS, FR_SCHLICK), dist=MD_GGX, r=0.0, r2=0.0, eta=1.0, cos_t=1e-7,
-         phi=0.0, u1=0.0, u2=0.0, u3=0.0, f0=5e-324, b=0.0, exponent=-1.0)   # was inf: R / P_R
-def test_microfacet_hazards(kind, dist, r, r2, eta, cos_t, phi, u1, u2, u3, f0, b, exponent):
+         phi=0.0, u1=0.0, u2=0.0, u3=0.0, f0=5e-324, b=0.0, exponent=-1.0, film=(0.0, 1.0))   # was inf: R / P_R
+def test_microfacet_hazards(kind, dist, r, r2, eta, cos_t, phi, u1, u2, u3, f0, b, exponent, film):
     ctype, fresnel = kind
     cl = microfacet_row(ctype=ctype, dist=dist, alpha=r * r, alpha_y=r2 * r2 if ctype == CT_MICROFACET else None,
                         eta=eta, fresnel=fresnel, f0=(f0, f0, f0) if fresnel != FR_CONDUCTOR else (eta, eta, eta),
                         f90=(b, b, b) if fresnel == FR_F82 else ((abs(b) * 5,) * 3 if fresnel == FR_CONDUCTOR
                                                                  else (1.0, 1.0, 1.0)),
-                        exponent=exponent, energy=1.0)
+                        exponent=exponent, energy=1.0, film=film)
     wo = _view(cos_t, phi)
     rng = np.random.default_rng(1)
     u = np.concatenate([[[u1, u2, u3]], rng.random((64, 3))])

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from ...jit import device
+from ..jit import device
 
 # Luminance: the Y row of the working space's RGB -> XYZ matrix.
 RGB_TO_Y = (0.212639, 0.715169, 0.072193)

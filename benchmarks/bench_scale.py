@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import gc
 import json
 import math
 import os
@@ -173,6 +174,10 @@ def _child(engine: str, blend: str, width: int, height: int, samples: int) -> in
         row.update(export_s=mc_engine.last_render["export_seconds"], bvh_s=stats.time_bvh,
                    kernels_s=stats.time_kernels,
                    prepare_s=timing["session"] - stats.time_bvh - stats.time_kernels)
+    # Let the 1-sample render's session go before the next one is built, as Blender does
+    # between two renders (held here, it added its film and geometry to the peak).
+    timing.clear()
+    gc.collect()
     (full, _sync), _rss = run(samples)
     pixels = width * height
     rate = pixels * (samples - 1) / max(full - first, 1e-9)

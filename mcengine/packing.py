@@ -63,6 +63,7 @@ from .kernels.state import (
 )
 from .kernels.svm import (
     OBJ_COLOR,
+    OBJ_HOLDOUT,
     OBJ_INVERSE,
     OBJ_MATRIX,
     OBJ_PASS_INDEX,
@@ -272,6 +273,7 @@ def pack_objects(g) -> np.ndarray:
         out[:o, OBJ_RANDOM] = info[:, 0]
         out[:o, OBJ_PASS_INDEX] = info[:, 1]
         out[:o, OBJ_COLOR:OBJ_COLOR + 4] = info[:, 2:6]
+    out[:o, OBJ_HOLDOUT] = [1.0 if info.holdout else 0.0 for info in g.object_pass_info()]
     terminator = g.terminator_offsets() if o else np.array([DEFAULT_TERMINATOR_OFFSETS])
     out[:, OBJ_TERMINATOR_GEOMETRY] = terminator[:, 0]
     # Cycles keeps the Shading Offset s as the frequency of its shift_cos_in (scene/object.cpp).

@@ -58,15 +58,18 @@ class SceneError(ValueError):
 
 @dataclass
 class ObjectPassInfo:
-    """What render passes know of an object besides its Object Info (``Geometry.object_info``,
-    which holds its pass index): its own name (the Cryptomatte object id; an instance's is
-    the instanced object's), the name of its topmost parent (the Cryptomatte asset id; its
-    own name without a parent), and whether its mesh has a UV map (else the UV pass reads 0,
-    as in Cycles)."""
+    """What the film and render passes know of an object besides its Object Info
+    (``Geometry.object_info``, which holds its pass index): its own name (the Cryptomatte
+    object id; an instance's is the instanced object's), the name of its topmost parent (the
+    Cryptomatte asset id; its own name without a parent), whether its mesh has a UV map (else
+    the UV pass reads 0, as in Cycles), and whether it is a holdout (Object > Visibility >
+    Holdout, or its collection's in the view layer: camera rays that reach it make the film
+    transparent, as a Holdout shader would)."""
 
     name: str = ""
     asset: str = ""
     has_uv: bool = True
+    holdout: bool = False
 
 
 @dataclass
@@ -91,7 +94,7 @@ class Geometry:
     object_info     (O, 6) float64     Object Info: random, pass index, colour RGBA
     object_terminator (O, 2) float64   Shadow Terminator: Geometry Offset and Shading Offset,
                     each in [0, 1] (``DEFAULT_TERMINATOR_OFFSETS`` when absent)
-    object_passes   per entry of ``object_names``, its :class:`ObjectPassInfo` (render passes;
+    object_passes   per entry of ``object_names``, its :class:`ObjectPassInfo` (render passes, holdout;
                     empty: each object is named by its ``object_names`` entry)
     """
 

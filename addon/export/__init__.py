@@ -174,7 +174,7 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
     from . import lights, materials, mesh, motion
 
     table = materials.MaterialTable(ctx)
-    collector = mesh.MeshCollector(ctx, table) if meshes else None
+    collector = mesh.MeshCollector(ctx, table, depsgraph.view_layer) if meshes else None
     light_list = []
     for inst in depsgraph.object_instances:
         if not inst.show_self:

@@ -49,7 +49,7 @@ _OBJECT_NOTES = {
     "point clouds": "these objects are skipped",
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
-    "holdout/shadow catcher": "these objects render as normal objects",
+    "shadow catcher": "these objects render as normal objects",
     SPHERE_SEAM: "their normal maps' tangents near it (object space x = 0, y < 0) may differ "
                  "from Cycles' (elsewhere they agree)",
 }
@@ -117,11 +117,14 @@ class MeshCollector:
     ctx : ExportContext
     materials : MaterialTable
         Maps each object's material slots to scene material indices.
+    view_layer : bpy.types.ViewLayer, optional
+        The depsgraph's view layer, where an object's collections may make it a holdout.
     """
 
-    def __init__(self, ctx, materials):
+    def __init__(self, ctx, materials, view_layer=None):
         self._ctx = ctx
         self._materials = materials
+        self._view_layer = view_layer
         self._meshes: dict[tuple, LocalMesh | None] = {}
         self._matrices: dict[tuple, list] = {}
         self._names: dict[tuple, list] = {}
@@ -153,8 +156,8 @@ class MeshCollector:
             return
         if any(not getattr(ob, f"visible_{ray}", True) for ray in _RAYS):
             self._note("ray visibility", ob.name)
-        if getattr(ob, "is_holdout", False) or getattr(ob, "is_shadow_catcher", False):
-            self._note("holdout/shadow catcher", ob.name)
+        if getattr(ob, "is_shadow_catcher", False):
+            self._note("shadow catcher", ob.name)
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
@@ -171,7 +174,7 @@ class MeshCollector:
             random_id = inst.random_id if inst.is_instance else object_random_id(ob.name)
             self._infos[key].append([float(random_id & 0xFFFFFFFF), float(ob.pass_index),
                                      *(float(c) for c in ob.color)])
-            self._passes[key].append(object_pass_info(ob))
+            self._passes[key].append(object_pass_info(ob, self._holdout(inst)))
             self._tags[key].append(tag)
             self._terminators[key].append((ob.shadow_terminator_geometry_offset,
                                            ob.shadow_terminator_shading_offset))
@@ -202,6 +205,18 @@ class MeshCollector:
                     self.layout.append((tag, (first, count), mesh, key[1], matrix))
                     first += count
         return geometry
+
+    def _holdout(self, inst) -> bool:
+        """Whether the instance is a holdout: its object's (an instance's: its instancer's)
+        own setting or its collection's in the view layer (Cycles' blender/object.cpp asks the
+        same of Blender; the original object and view layer answer, evaluated ones do not)."""
+        ob = (inst.parent if inst.is_instance else inst.object).original
+        if self._view_layer is not None:
+            try:
+                return bool(ob.holdout_get(view_layer=self._view_layer))
+            except RuntimeError:      # not in the view layer (Blender reports it): its own flag
+                pass
+        return bool(getattr(ob, "is_holdout", False))
 
     def _note(self, feature: str, object_name: str) -> None:
         names = self._noted.setdefault(feature, [])
@@ -258,16 +273,16 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
                      tangents_failed=tangents_failed)
 
 
-def object_pass_info(ob) -> ObjectPassInfo:
-    """What render passes need of an object besides its Object Info (Cycles'
+def object_pass_info(ob, holdout: bool = False) -> ObjectPassInfo:
+    """What the film and render passes need of an object besides its Object Info (Cycles'
     blender/object.cpp): its name, the name of its topmost parent (the Cryptomatte asset; its
-    own without a parent), whether its mesh has a UV map."""
+    own without a parent), whether its mesh has a UV map, and ``holdout``."""
     root = ob
     while root.parent is not None:
         root = root.parent
     uv_layers = getattr(ob.data, "uv_layers", None)
     return ObjectPassInfo(name=ob.name, asset=root.name,
-                          has_uv=bool(uv_layers is not None and len(uv_layers)))
+                          has_uv=bool(uv_layers is not None and len(uv_layers)), holdout=holdout)
 
 
 def transform_instances(mesh: LocalMesh, matrices, unit_scale: float, names,

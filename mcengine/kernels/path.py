@@ -39,6 +39,7 @@ from .closures.layout import (
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
+    CT_TRANSPARENT,
     LABEL_DIFFUSE,
     LABEL_REFLECT,
     LABEL_SINGULAR,
@@ -122,9 +123,23 @@ from .state import (
     move_path,
 )
 from .surface import hit_distance, past_self_hit, surface_point
+from .svm import OBJ_HOLDOUT
 
 
 # -- 3. shading ---------------------------------------------------------------------------------
+@device
+def _keep_transparent(cl, n):
+    """Drop every closure but the transparent one (at most one: closures merge them);
+    returns the new count."""
+    for k in range(n):
+        if cl[k, CL_TYPE] == CT_TRANSPARENT:
+            if k > 0:
+                for c in range(cl.shape[1]):
+                    cl[0, c] = cl[k, c]
+            return 1
+    return 0
+
+
 @kernel
 def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     """Shade the hits of the n live paths; returns the number of queued shadow rays.
@@ -220,13 +235,24 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
                           not terminate, depths, footprint)
 
-        # Holdout: the film's alpha drops by the holdout weight on camera paths.
-        if res.holdout > 0.0 and (flags & PF_TRANSPARENT_BG):
-            st.transparency[i] += res.holdout * (st.beta[i, 0] + st.beta[i, 1] + st.beta[i, 2]) / 3.0
-            if res.holdout >= 1.0:
-                continue
+        # Holdout: the film's alpha drops by the holdout weight on camera paths. A holdout
+        # object's weight is its opacity, 1 - transparency; only its transparent closure
+        # stays, without emission (Cycles' surface_shader_apply_holdout).
+        ncl = res.n
+        emits = res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0
+        if flags & PF_TRANSPARENT_BG:
+            if sc.tex.objects[sc.tex.tri_object[p], OBJ_HOLDOUT] > 0.0:
+                ncl = _keep_transparent(scratch.cl, ncl)
+                emits = False
+                hr, hg, hb = max(1.0 - res.tr, 0.0), max(1.0 - res.tg, 0.0), max(1.0 - res.tb, 0.0)
+            else:
+                hr = hg = hb = res.holdout
+            if hr > 0.0 or hg > 0.0 or hb > 0.0:
+                st.transparency[i] += (hr * st.beta[i, 0] + hg * st.beta[i, 1] + hb * st.beta[i, 2]) / 3.0
+                if hr >= 1.0 and hg >= 1.0 and hb >= 1.0:
+                    continue
         # Emission (two-sided).
-        if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
+        if emits:
             if light_passes:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
@@ -234,9 +260,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
-        if terminate or res.n == 0:
+        if terminate or ncl == 0:
             continue
-        ncl = res.n
         if caustics and fcfg[FCFG_FILTER_GLOSSY] > 0.0:
             blur_closures(scratch.cl, ncl, fcfg[FCFG_FILTER_GLOSSY] * st.min_pdf[i])
 

@@ -45,7 +45,9 @@ def test_scenes_exist():
             "texture_checker_lights", "attribute_vertex_colors", "texture_suzanne_maps",
             "world_hdri_interior",
             # the tangents of anisotropic closures; thin-film interference
-            "material_anisotropic", "material_thin_film"} <= names
+            "material_anisotropic", "material_thin_film",
+            # holdout objects and collections
+            "holdout_objects"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

@@ -105,6 +105,21 @@ def test_ignored_thin_films_are_caught(renders):
     assert any(d["t"] > 0 for d in differing) and any(d["t"] < 0 for d in differing), differing
 
 
+def _without_holdouts(scene):
+    bpy.data.objects["Held"].is_holdout = False
+    for layer in scene.view_layers:
+        layer.layer_collection.children["Masked"].holdout = False
+
+
+def test_ignored_holdouts_are_caught(renders):
+    """Holdout objects rendered as ordinary ones (what MC Engine did before it had them):
+    the two spheres, black in Cycles' image, show their colours; only brighter blocks."""
+    result = renders.compare("holdout_objects", "no holdouts", _without_holdouts)
+    assert result.verdict == "differ"
+    differing = result.agreement.differing_blocks()
+    assert differing and all(d["t"] > 0 for d in differing), differing
+
+
 def _unlinked(material, socket_owner, socket):
     def edit(scene):
         tree = bpy.data.materials[material].node_tree

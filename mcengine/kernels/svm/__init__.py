@@ -49,6 +49,7 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     ATTR_DEFAULT_UV,
     IMG_STRIDE,
     OBJ_COLOR,
+    OBJ_HOLDOUT,
     OBJ_INVERSE,
     OBJ_MATRIX,
     OBJ_PASS_INDEX,

@@ -125,6 +125,7 @@ class MeshCollector:
         self._ctx = ctx
         self._materials = materials
         self._view_layer = view_layer
+        self._holdouts: dict[int, bool] = {}      # by original object: one question each
         self._meshes: dict[tuple, LocalMesh | None] = {}
         self._matrices: dict[tuple, list] = {}
         self._names: dict[tuple, list] = {}
@@ -211,12 +212,16 @@ class MeshCollector:
         own setting or its collection's in the view layer (Cycles' blender/object.cpp asks the
         same of Blender; the original object and view layer answer, evaluated ones do not)."""
         ob = (inst.parent if inst.is_instance else inst.object).original
-        if self._view_layer is not None:
-            try:
-                return bool(ob.holdout_get(view_layer=self._view_layer))
-            except RuntimeError:      # not in the view layer (Blender reports it): its own flag
-                pass
-        return bool(getattr(ob, "is_holdout", False))
+        key = ob.as_pointer()
+        if key not in self._holdouts:
+            held = None
+            if self._view_layer is not None:
+                try:
+                    held = bool(ob.holdout_get(view_layer=self._view_layer))
+                except RuntimeError:  # not in the view layer (Blender reports it): its own flag
+                    pass
+            self._holdouts[key] = bool(getattr(ob, "is_holdout", False)) if held is None else held
+        return self._holdouts[key]
 
     def _note(self, feature: str, object_name: str) -> None:
         names = self._noted.setdefault(feature, [])

@@ -317,6 +317,11 @@ class RenderSession:
             self.light_tables, self.warnings = light_tracing.prepare(scene, self.sc, self.cfg,
                                                                      self.plan)
         self._classic_setup()
+        if self._classic and ("holdout" in self.plan.lobes or any(
+                info.holdout for info in scene.geometry.object_pass_info())):
+            self.warnings.append(f"{self.integrator.name} does not render holdouts (Holdout "
+                                 f"shaders and holdout objects): they render as ordinary "
+                                 f"surfaces; Path Tracing renders them as Cycles")
         guides = ((P_DENOISING_ALBEDO,) if scene.denoising.uses_albedo else ()) + \
             ((P_DENOISING_NORMAL,) if scene.denoising.uses_normal else ())
         self.pass_layout = render_passes.layout(scene.passes, guides)

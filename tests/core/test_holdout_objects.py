@@ -66,3 +66,24 @@ def test_a_half_transparent_holdout_object_keeps_only_what_is_seen_through_it():
     assert alpha == pytest.approx(0.0, abs=1e-6) and rgb == pytest.approx(0.0, abs=1e-6)
     rgb, alpha = _mean_rgba(render(_scene(_half_transparent_emitter(), holdout=False)))
     assert alpha == pytest.approx(1.0, abs=1e-6) and rgb == pytest.approx(1.5 + 0.5 * WORLD, rel=1e-6)
+
+
+@pytest.mark.parametrize("name", ["raycast", "whitted", "distribution"])
+def test_the_classic_integrators_say_they_do_not_render_holdouts(name):
+    """They shade a holdout as an ordinary surface; the session's warnings say so (for a
+    holdout object and for a Holdout shader), and say nothing without either."""
+    import dataclasses
+
+    from mcengine.session import RenderSession
+
+    emitter = Material(nodes=[ShaderNode("Emission", {"Color": (1.0, 1.0, 1.0), "Strength": 1.0})],
+                       surface=Link(0, "Emission"))
+    shader = Material(nodes=[ShaderNode("Holdout")], surface=Link(0, "Holdout"))
+    for material, holdout, warned in ((emitter, True, True), (shader, False, True),
+                                      (emitter, False, False)):
+        scene = _scene(material, holdout=holdout)
+        scene.integrator = dataclasses.replace(scene.integrator, name=name, depth=2)
+        notes = [w for w in RenderSession(scene).warnings if "holdout" in w]
+        assert bool(notes) == warned, (name, holdout, notes)
+    scene = _scene(shader, holdout=True)
+    assert not [w for w in RenderSession(scene).warnings if "holdout" in w]    # path tracing

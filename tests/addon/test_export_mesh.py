@@ -309,8 +309,7 @@ def test_holdout_objects_and_collections_are_exported(scene, fake_session):
     new_mesh_object("Catcher", TRI, [(0, 1, 2)]).is_shadow_catcher = True
     desc = export_scene(fake_session)
     g = desc.geometry
-    held = {info.name if "/" not in name else name: info.holdout
-            for name, info in zip(g.object_names, g.object_pass_info())}
+    held = {name: info.holdout for name, info in zip(g.object_names, g.object_pass_info())}
     assert held == {"Plain": False, "Own": True, "InMasked": True, "InstHeld/Tri": True,
                     "InstShown/Tri": False, "Catcher": False}
     assert [w for w in desc.warnings if "holdout" in w] == []

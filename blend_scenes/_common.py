@@ -441,6 +441,15 @@ def add_uv_sphere(scene, name, radius, material, smooth=True,
     return add_mesh(scene, name, vertices, faces, material, smooth=smooth, **transform)
 
 
+def sphere_grid(count, radius, spacing, columns=3):
+    """Locations of ``count`` spheres of ``radius`` resting on the floor (z = 0), in rows of
+    ``columns`` ``spacing`` apart, centred on the origin: the first row at the back (largest
+    y), each row from left to right."""
+    rows = (count + columns - 1) // columns
+    return [((column - (columns - 1) / 2) * spacing, ((rows - 1) / 2 - row) * spacing, radius)
+            for row, column in (divmod(i, columns) for i in range(count))]
+
+
 def add_cylinder(scene, name, radius, height, material, segments=SPHERE_SEGMENTS, **transform):
     """Add a closed cylinder standing on the object origin (z = 0 .. height).
 

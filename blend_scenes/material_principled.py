@@ -62,10 +62,9 @@ def build(scene):
     c.set_world(scene, (0.05, 0.06, 0.08))
     c.set_bounces(scene, 8, 4, glossy=8, transmission=8)
     c.add_floor(scene)
-    for i, (name, values) in enumerate(VARIANTS):
-        row, column = divmod(i, 3)
+    for (name, values), location in zip(VARIANTS, c.sphere_grid(len(VARIANTS), RADIUS, SPACING)):
         c.add_uv_sphere(scene, name, RADIUS, c.node_material(name, PRINCIPLED, **values),
-                        location=((column - 1) * SPACING, (1 - row) * SPACING, RADIUS))
+                        location=location)
     c.add_light(scene, "Key", "AREA", 300.0, (-2.0, -2.2, 3.6), target=(0.0, 0.0, 0.3),
                 shape="SQUARE", size=3.0)
     c.add_camera(scene, (0.0, -3.2, 4.9), (0.0, 0.0, 0.3), lens_mm=58.0)

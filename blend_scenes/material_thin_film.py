@@ -55,10 +55,8 @@ def build(scene):
     c.set_world(scene, (0.35, 0.35, 0.38))
     c.set_bounces(scene, 8, 4, glossy=8, transmission=8)
     c.add_floor(scene)
-    for i, (name, node, values) in enumerate(VARIANTS):
-        row, column = divmod(i, 3)
-        c.add_uv_sphere(scene, name, RADIUS, c.node_material(name, node, **values),
-                        location=((column - 1) * SPACING, (0.5 - row) * SPACING, RADIUS))
+    for (name, node, values), location in zip(VARIANTS, c.sphere_grid(len(VARIANTS), RADIUS, SPACING)):
+        c.add_uv_sphere(scene, name, RADIUS, c.node_material(name, node, **values), location=location)
     c.add_light(scene, "Key", "AREA", 300.0, (-2.0, -2.2, 3.6), target=(0.0, 0.0, 0.3),
                 shape="SQUARE", size=3.0)
     c.add_camera(scene, (0.0, -3.3, 3.6), (0.0, 0.0, 0.35), lens_mm=55.0)

@@ -4,8 +4,9 @@ All functions are scalar (one colour channel); ``eta`` is the relative index of 
 n_t / n_i across the interface (below 1 when leaving a denser medium).
 
 * ``fresnel_dielectric`` is the exact unpolarised reflectance of a smooth dielectric
-  interface, as the average of the s- and p-polarised reflectances (Cycles'
-  ``fresnel_dielectric_polarized``), with the cosine of the refracted direction;
+  interface, as the average of the s- and p-polarised reflectances of
+  ``fresnel_dielectric_polarized`` (their signed amplitudes, as Cycles' function of that
+  name), with the cosine of the refracted direction;
 * ``F0_from_ior``/``ior_from_F0`` convert between the IOR and the reflectance at normal
   incidence; ``fresnel_dielectric_Fss`` is Kulla and Conty's fit of its cosine-weighted
   hemispherical average (the single-scattering Fresnel of energy compensation);
@@ -13,8 +14,9 @@ n_t / n_i across the interface (below 1 when leaving a denser medium).
   Material"): Schlick's curve minus ``B cos (1 - cos)^6``, with B chosen from a tint of
   the value at cos = 1/7 (about 82 degrees);
 * the conductor Fresnel of a complex IOR n + ik (``fresnel_conductor``: Born and Wolf's
-  s- and p-polarised reflectances, averaged, as Cycles' ``fresnel_conductor``), and its
-  average through the F82 model fitted at cos = 1 and 1/7 (``fresnel_conductor_Fss``);
+  s- and p-polarised reflectances of ``fresnel_conductor_polarized``, averaged, as Cycles'
+  ``fresnel_conductor``), and its average through the F82 model fitted at cos = 1 and 1/7
+  (``fresnel_conductor_Fss``);
 * the generalized Schlick model: the interpolation factor s between F0 and F90, either
   ``(1 - cos)^exponent`` or, for a negative exponent, the exact dielectric Fresnel
   remapped from [F0(eta), 1] to [0, 1] (what every Blender 5.0 node uses).
@@ -27,23 +29,35 @@ from ...jit import device
 
 
 @device
-def fresnel_dielectric(cos_i, eta):
-    """Unpolarised Fresnel reflectance and cos(theta_t) for relative IOR eta = n_t / n_i.
+def fresnel_dielectric_polarized(cos_i, eta):
+    """(r_s, r_p, cos_t): the s- and p-polarised amplitude ratios of a dielectric interface of
+    relative IOR eta = n_t / n_i, and the cosine of the refracted direction.
 
     ``cos_i`` is the cosine between the incident direction and the normal; its sign is
-    ignored (Cycles takes |cos_i| too).  Returns (F, cos_t) with cos_t >= 0 the cosine of
-    the refracted direction on the far side, and F = 1, cos_t = 0 under total internal
-    reflection (when eta^2 - 1 + cos_i^2 <= 0, exactly Cycles' test).  F is the mean of
-    the s- and p-polarised reflectances.
+    ignored (Cycles takes |cos_i| too).  The amplitudes carry their sign (a phase shift of 0
+    or pi on reflection, which thin films need); their squares are the reflectances.
+    cos_t >= 0 is the refracted cosine on the far side.  Under total internal reflection
+    (when eta^2 - 1 + cos_i^2 <= 0, exactly Cycles' test): (1, 1, 0).
     """
     c = abs(cos_i)
     eta_cos_t_sq = eta * eta - 1.0 + c * c    # (eta cos_t)^2, without cancellation near grazing
     if eta_cos_t_sq <= 0.0:
-        return 1.0, 0.0
+        return 1.0, 1.0, 0.0
     eta_cos_t = math.sqrt(eta_cos_t_sq)
-    rs = (c - eta_cos_t) / (c + eta_cos_t)
-    rp = (eta * eta * c - eta_cos_t) / (eta * eta * c + eta_cos_t)
-    return 0.5 * (rs * rs + rp * rp), min(eta_cos_t / eta, 1.0)
+    r_s = (c - eta_cos_t) / (c + eta_cos_t)
+    r_p = (eta * eta * c - eta_cos_t) / (eta * eta * c + eta_cos_t)
+    return r_s, r_p, min(eta_cos_t / eta, 1.0)
+
+
+@device
+def fresnel_dielectric(cos_i, eta):
+    """Unpolarised Fresnel reflectance and cos(theta_t) for relative IOR eta = n_t / n_i.
+
+    Returns (F, cos_t), F the mean of the s- and p-polarised reflectances of
+    ``fresnel_dielectric_polarized``: F = 1, cos_t = 0 under total internal reflection.
+    """
+    r_s, r_p, cos_t = fresnel_dielectric_polarized(cos_i, eta)
+    return 0.5 * (r_s * r_s + r_p * r_p), cos_t
 
 
 @device
@@ -148,23 +162,37 @@ def generalized_schlick_s(cos_i, eta, exponent):
 
 
 @device
+def fresnel_conductor_polarized(cos_i, eta_i, n, k):
+    """(R_s, R_p, u, v) of a conductor of complex IOR n + ik under a dielectric of IOR eta_i,
+    at incidence cosine cos_i (Born and Wolf; Cycles' fresnel_conductor_polarized).
+
+    R_s and R_p are the s- and p-polarised reflectances; u + iv = sqrt((n + ik)^2 -
+    eta_i^2 sin^2 theta_i), the complex refracted cosine times n + ik, from which thin films
+    take the phase of the reflected waves.
+    """
+    c = min(cos_i, 1.0)
+    n2, k2 = n * n, k * k
+    t1 = n2 - k2 - eta_i * eta_i * (1.0 - c * c)
+    t2 = math.sqrt(t1 * t1 + 4.0 * n2 * k2)
+    u = math.sqrt(max(0.5 * (t2 + t1), 0.0))
+    v = math.sqrt(max(0.5 * (t2 - t1), 0.0))
+    ec = eta_i * c
+    den = (ec + u) * (ec + u) + v * v
+    r_s = ((ec - u) * (ec - u) + v * v) / den if den != 0.0 else 0.0
+    t3 = (n2 - k2) * c
+    t4 = 2.0 * n * k * c
+    den = (t3 + eta_i * u) * (t3 + eta_i * u) + (t4 + eta_i * v) * (t4 + eta_i * v)
+    r_p = (((t3 - eta_i * u) * (t3 - eta_i * u) + (t4 - eta_i * v) * (t4 - eta_i * v)) / den
+           if den != 0.0 else 0.0)
+    return r_s, r_p, u, v
+
+
+@device
 def fresnel_conductor(cos_i, n, k):
     """Unpolarised reflectance of a conductor of complex IOR n + ik seen from a medium of
     IOR 1, at incidence cosine cos_i (Cycles' fresnel_conductor_polarized, averaged)."""
-    c = min(cos_i, 1.0)
-    n2, k2 = n * n, k * k
-    t1 = n2 - k2 - (1.0 - c * c)
-    t2 = math.sqrt(t1 * t1 + 4.0 * n2 * k2)
-    u_sq = max(0.5 * (t2 + t1), 0.0)
-    v_sq = max(0.5 * (t2 - t1), 0.0)
-    u, v = math.sqrt(u_sq), math.sqrt(v_sq)
-    den = (c + u) * (c + u) + v_sq
-    rs = ((c - u) * (c - u) + v_sq) / den if den != 0.0 else 0.0
-    t3 = (n2 - k2) * c
-    t4 = 2.0 * n * k * c
-    den = (t3 + u) * (t3 + u) + (t4 + v) * (t4 + v)
-    rp = ((t3 - u) * (t3 - u) + (t4 - v) * (t4 - v)) / den if den != 0.0 else 0.0
-    return 0.5 * (rs + rp)
+    r_s, r_p, _, _ = fresnel_conductor_polarized(cos_i, 1.0, n, k)
+    return 0.5 * (r_s + r_p)
 
 
 @device

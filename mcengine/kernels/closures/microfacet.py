@@ -423,22 +423,26 @@ def _film_fresnel(cl, k, cos_hi, film, model, eta, cos_t, has_r, has_t):
                 fb * cl[k, CL_RTINT + 2] * has_r, (1.0 - fr) * cl[k, CL_TTINT] * has_t,
                 (1.0 - fg) * cl[k, CL_TTINT + 1] * has_t, (1.0 - fb) * cl[k, CL_TTINT + 2] * has_t,
                 cos_t)
-    rr = rg = rb = 0.0
-    for ch in range(3):
-        if model == FR_F82:
-            f0 = cl[k, CL_F0 + ch]
-            f82 = fresnel_f82(1.0 / 7.0, f0, cl[k, CL_F90 + ch])
-            n, kk = f82_conductor_ior(f0, f82)
-        else:
-            n, kk, f82 = cl[k, CL_F0 + ch], cl[k, CL_F90 + ch], -1.0
-        v = iridescence_conductor(ch, c, film, film_ior, n, kk, f82)
-        if ch == 0:
-            rr = v
-        elif ch == 1:
-            rg = v
-        else:
-            rb = v
+    if model == FR_F82:
+        n_r, k_r, f82_r = _f82_conductor(cl[k, CL_F0], cl[k, CL_F90])
+        n_g, k_g, f82_g = _f82_conductor(cl[k, CL_F0 + 1], cl[k, CL_F90 + 1])
+        n_b, k_b, f82_b = _f82_conductor(cl[k, CL_F0 + 2], cl[k, CL_F90 + 2])
+    else:
+        n_r, n_g, n_b = cl[k, CL_F0], cl[k, CL_F0 + 1], cl[k, CL_F0 + 2]
+        k_r, k_g, k_b = cl[k, CL_F90], cl[k, CL_F90 + 1], cl[k, CL_F90 + 2]
+        f82_r = f82_g = f82_b = -1.0
+    rr, rg, rb = iridescence_conductor(c, film, film_ior, (n_r, n_g, n_b), (k_r, k_g, k_b),
+                                       (f82_r, f82_g, f82_b))
     return rr * has_r, rg * has_r, rb * has_r, 0.0, 0.0, 0.0, cos_t
+
+
+@device
+def _f82_conductor(f0, b):
+    """(n, k, F82) of the F82 row channel with F0 = f0 and B = b: its value at cos = 1/7 and
+    the n + ik estimated from the two (what a film on an F82-tint metal reflects on)."""
+    f82 = fresnel_f82(1.0 / 7.0, f0, b)
+    n, k = f82_conductor_ior(f0, f82)
+    return n, k, f82
 
 
 @device

@@ -29,31 +29,12 @@ from __future__ import annotations
 import math
 
 from ...jit import device
-from .fresnel import f82_B, fresnel_f82
+from .fresnel import f82_B, fresnel_conductor_polarized, fresnel_dielectric_polarized, fresnel_f82
 from .tables import THIN_FILM_IM, THIN_FILM_RE, lookup_row
 
 THIN_FILM_CUTOFF = 0.1       # nm: thinner films are absent (Cycles' THINFILM_THICKNESS_CUTOFF)
 _TABLE_OPD_NM = 60000.0      # x = 2 pi OPD / this: the table spans x in [0, 1]
 _AIRY_ORDERS = 3             # terms of the series beyond the incoherent sum
-
-
-@device
-def dielectric_polarized(cos_i, eta):
-    """(Rs, Rp, cos_t, phase_s, phase_p) of a dielectric interface of relative IOR eta.
-
-    Rs and Rp are the squared s- and p-amplitude ratios, cos_t >= 0 the refracted cosine,
-    phase_s/_p = +1 or -1 the sign of each amplitude (a phase shift of 0 or pi).  Under
-    total internal reflection: (1, 1, 0, 1, 1).
-    """
-    c = abs(cos_i)
-    eta_cos_t_sq = eta * eta - 1.0 + c * c
-    if eta_cos_t_sq <= 0.0:
-        return 1.0, 1.0, 0.0, 1.0, 1.0
-    cos_t = math.sqrt(eta_cos_t_sq) / eta
-    r_s = (c - eta * cos_t) / (c + eta * cos_t)
-    r_p = (eta * c - cos_t) / (eta * c + cos_t)
-    return (r_s * r_s, r_p * r_p, cos_t,
-            1.0 if r_s >= 0.0 else -1.0, 1.0 if r_p >= 0.0 else -1.0)
 
 
 @device
@@ -96,19 +77,34 @@ def _sat(x):
 
 
 @device
+def _sign(x):
+    return 1.0 if x >= 0.0 else -1.0
+
+
+@device
+def _top_interface(cos_i, thickness, film_ior):
+    """(n_f, R_s, R_p, cos_film, phase_s, phase_p) of the film's top interface, seen from a
+    medium of IOR 1: the film's IOR, the reflectances, the cosine inside the film and the
+    sign of each amplitude.  R_s = R_p = 1 under total internal reflection."""
+    nf = _film_ior(thickness, film_ior)
+    r_s, r_p, cos_f = fresnel_dielectric_polarized(cos_i, nf)
+    return nf, r_s * r_s, r_p * r_p, cos_f, _sign(r_s), _sign(r_p)
+
+
+@device
 def iridescence_dielectric(cos_i, thickness, film_ior, eta):
     """RGB reflectance of a film (thickness nm, IOR ``film_ior``) on a dielectric of relative
     IOR ``eta``, seen at incidence cosine ``cos_i`` from a medium of IOR 1."""
-    nf = _film_ior(thickness, film_ior)
-    r12s, r12p, cos_2, ph12s, ph12p = dielectric_polarized(cos_i, nf)
+    nf, r12s, r12p, cos_2, ph12s, ph12p = _top_interface(cos_i, thickness, film_ior)
     if r12s == 1.0 and r12p == 1.0:
         return 1.0, 1.0, 1.0            # total internal reflection at the top
-    r23s, r23p, _, ph23s, ph23p = dielectric_polarized(cos_2, eta / nf)
+    a23s, a23p, _ = fresnel_dielectric_polarized(cos_2, eta / nf)
+    r23s, r23p = a23s * a23s, a23p * a23p
     if r23s == 1.0 and r23p == 1.0:
         return 1.0, 1.0, 1.0            # ... at the bottom: the series sums to 1
     opd = 2.0 * nf * thickness * cos_2
-    ps = -ph23s * ph12s
-    pp = -ph23p * ph12p
+    ps = -_sign(a23s) * ph12s
+    pp = -_sign(a23p) * ph12p
     r = 0.5 * (_airy(0, r12s, r23s, opd, ps, 0.0) + _airy(0, r12p, r23p, opd, pp, 0.0))
     g = 0.5 * (_airy(1, r12s, r23s, opd, ps, 0.0) + _airy(1, r12p, r23p, opd, pp, 0.0))
     b = 0.5 * (_airy(2, r12s, r23s, opd, ps, 0.0) + _airy(2, r12p, r23p, opd, pp, 0.0))
@@ -124,45 +120,41 @@ def _unit(re, im):
 
 
 @device
-def iridescence_conductor(channel, cos_i, thickness, film_ior, n, k, f82):
-    """Channel ``channel`` of the reflectance of a film on a conductor of IOR n + ik.
-
-    With ``f82 >= 0`` the bottom interface reflects as the F82 model whose F0 is that of
-    n + ik seen from the film and whose value at cos = 1/7 is ``f82`` (Cycles' F82-tint
-    metal); the phase always comes from n + ik.
-    """
-    nf = _film_ior(thickness, film_ior)
-    r12s, r12p, cos_2, ph12s, ph12p = dielectric_polarized(cos_i, nf)
-    if r12s == 1.0 and r12p == 1.0:
-        return 1.0
-    # The bottom interface, seen from the film (Born and Wolf).
-    c = cos_2
-    n2, k2 = n * n, k * k
-    nk2 = 2.0 * n * k
-    t1 = n2 - k2 - nf * nf * (1.0 - c * c)
-    t2 = math.sqrt(t1 * t1 + nk2 * nk2)
-    u_sq = max(0.5 * (t2 + t1), 0.0)
-    v_sq = max(0.5 * (t2 - t1), 0.0)
-    u, v = math.sqrt(u_sq), math.sqrt(v_sq)
+def _conductor_channel(channel, nf, r12s, r12p, c, ph12s, ph12p, thickness, n, k, f82):
+    """Channel ``channel`` of a film on a conductor of IOR n + ik, given its top interface
+    (``_top_interface``; c the cosine inside the film)."""
+    r23s, r23p, u, v = fresnel_conductor_polarized(c, nf, n, k)
     if f82 >= 0.0:
         rn = n / nf
         rk_sq = (k / nf) ** 2
         f0 = ((rn - 1.0) ** 2 + rk_sq) / ((rn + 1.0) ** 2 + rk_sq)
         r23s = r23p = fresnel_f82(c, f0, f82_B(f0, f82))
-    else:
-        den = (nf * c + u) ** 2 + v_sq
-        r23s = ((nf * c - u) ** 2 + v_sq) / den if den != 0.0 else 0.0
-        t3 = (n2 - k2) * c
-        t4 = nk2 * c
-        den = (t3 + nf * u) ** 2 + (t4 + nf * v) ** 2
-        r23p = ((t3 - nf * u) ** 2 + (t4 - nf * v) ** 2) / den if den != 0.0 else 0.0
-    ph23s_re, ph23s_im = _unit(nf * nf * c * c - u_sq - v_sq, -2.0 * nf * c * v)
-    ph23p_re, ph23p_im = _unit(((n2 + k2) * c) ** 2 - nf * nf * (u_sq + v_sq),
-                               2.0 * nf * c * (nk2 * u - (n2 - k2) * v))
+    n2, k2 = n * n, k * k
+    uv2 = u * u + v * v
+    ph23s_re, ph23s_im = _unit(nf * nf * c * c - uv2, -2.0 * nf * c * v)
+    ph23p_re, ph23p_im = _unit(((n2 + k2) * c) ** 2 - nf * nf * uv2,
+                               2.0 * nf * c * (2.0 * n * k * u - (n2 - k2) * v))
     opd = 2.0 * nf * thickness * c
     rs = _airy(channel, r12s, r23s, opd, -ph12s * ph23s_re, -ph12s * ph23s_im)
     rp = _airy(channel, r12p, r23p, opd, -ph12p * ph23p_re, -ph12p * ph23p_im)
     return _sat(0.5 * (rs + rp))
+
+
+@device
+def iridescence_conductor(cos_i, thickness, film_ior, n, k, f82):
+    """RGB reflectance of a film on a conductor; ``n``, ``k`` and ``f82`` are RGB triples.
+
+    Per channel, the bottom interface is the conductor n + ik seen from the film (Born and
+    Wolf); with ``f82 >= 0`` it reflects as the F82 model whose F0 is that of n + ik seen
+    from the film and whose value at cos = 1/7 is ``f82`` (Cycles' F82-tint metal); the
+    phase always comes from n + ik.
+    """
+    nf, r12s, r12p, c, ph12s, ph12p = _top_interface(cos_i, thickness, film_ior)
+    if r12s == 1.0 and r12p == 1.0:
+        return 1.0, 1.0, 1.0
+    return (_conductor_channel(0, nf, r12s, r12p, c, ph12s, ph12p, thickness, n[0], k[0], f82[0]),
+            _conductor_channel(1, nf, r12s, r12p, c, ph12s, ph12p, thickness, n[1], k[1], f82[1]),
+            _conductor_channel(2, nf, r12s, r12p, c, ph12s, ph12p, thickness, n[2], k[2], f82[2]))
 
 
 @device

@@ -78,7 +78,7 @@ def test_film_on_a_conductor_matches_the_spectral_integral(n, k):
     """Cycles' conductor phase is that of the refractive index n + ik (exp(-i w t) waves)."""
     substrate = np.array(n) + 1j * np.array(k)
     for cos_i, d, film in GRID:
-        ours = np.array([iridescence_conductor(c, cos_i, d, film, n[c], k[c], -1.0) for c in range(3)])
+        ours = np.array(iridescence_conductor(cos_i, d, film, n, k, (-1.0,) * 3))
         bound = 1.2e-2 if cos_i >= 0.7 else 7e-2
         assert ours == pytest.approx(exact_film_rgb(cos_i, d, film, substrate), abs=bound), (cos_i, d, film)
 
@@ -91,7 +91,8 @@ def test_the_colours_are_those_of_the_film_not_an_average():
     assert np.max(np.abs(exact - plain)) > 0.02
     n, k = 0.18, 3.42
     wrong_phase = exact_film_rgb(0.7, 250.0, 1.8, n - 1j * k)[0]
-    assert abs(iridescence_conductor(0, 0.7, 250.0, 1.8, n, k, -1.0) - wrong_phase) > 0.02
+    assert abs(iridescence_conductor(0.7, 250.0, 1.8, (n,) * 3, (k,) * 3, (-1.0,) * 3)[0]
+               - wrong_phase) > 0.02
 
 
 def test_an_index_matched_film_is_no_film():
@@ -102,8 +103,9 @@ def test_an_index_matched_film_is_no_film():
         assert iridescence_dielectric(cos_i, d, 1.0, eta) == pytest.approx((plain,) * 3, abs=1e-12)
         assert iridescence_dielectric(cos_i, d, eta, eta) == pytest.approx((plain,) * 3, abs=1e-12)
     for cos_i in (1.0, 0.5, 0.05):
-        assert iridescence_conductor(1, cos_i, 300.0, 1.0, 0.2, 3.0, -1.0) == pytest.approx(
-            fresnel_conductor(cos_i, 0.2, 3.0), abs=1e-12)
+        assert iridescence_conductor(cos_i, 300.0, 1.0, (0.2, 0.5, 1.5), (3.0, 2.0, 0.0), (-1.0,) * 3) == (
+            pytest.approx([fresnel_conductor(cos_i, 0.2, 3.0), fresnel_conductor(cos_i, 0.5, 2.0),
+                           fresnel_conductor(cos_i, 1.5, 0.0)], abs=1e-12))
 
 
 def test_f82_metal_under_an_index_matched_film_keeps_its_f82_curve():
@@ -114,8 +116,8 @@ def test_f82_metal_under_an_index_matched_film_keeps_its_f82_curve():
     n, k = f82_conductor_ior(f0, f82)
     assert fresnel_conductor(1.0, n, k) == pytest.approx(f0, abs=1e-12)
     for cos_i in (1.0, 0.6, 0.2):
-        assert iridescence_conductor(0, cos_i, 300.0, 1.0, n, k, f82) == pytest.approx(
-            fresnel_f82(cos_i, f0, b), abs=1e-12)
+        assert iridescence_conductor(cos_i, 300.0, 1.0, (n,) * 3, (k,) * 3, (f82,) * 3) == pytest.approx(
+            (fresnel_f82(cos_i, f0, b),) * 3, abs=1e-12)
 
 
 def test_specular_tint_scales_the_film_towards_F0():
@@ -166,7 +168,8 @@ def test_hazards_stay_finite_and_in_range():
                                                  (1e-5, 1.0, 1.33, 10.0), (1e-5, 0.67, 1.0, 1.5, 10.0)):
         rgb = iridescence_dielectric(cos_i, d, film, eta)
         assert all(0.0 <= v <= 1.0 for v in rgb), (cos_i, d, film, eta, rgb)
-        v = iridescence_conductor(0, cos_i, d, film, eta, 3.0 * eta, -1.0)
-        assert 0.0 <= v <= 1.0, (cos_i, d, film, eta, v)
-        v = iridescence_conductor(2, cos_i, d, film, *f82_conductor_ior(min(eta, 1.0), 0.5), 0.5)
-        assert 0.0 <= v <= 1.0, (cos_i, d, film, eta, v)
+        rgb = iridescence_conductor(cos_i, d, film, (eta,) * 3, (3.0 * eta,) * 3, (-1.0,) * 3)
+        assert all(0.0 <= v <= 1.0 for v in rgb), (cos_i, d, film, eta, rgb)
+        n, k = f82_conductor_ior(min(eta, 1.0), 0.5)
+        rgb = iridescence_conductor(cos_i, d, film, (n,) * 3, (k,) * 3, (0.5,) * 3)
+        assert all(0.0 <= v <= 1.0 for v in rgb), (cos_i, d, film, eta, rgb)

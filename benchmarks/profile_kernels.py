@@ -11,8 +11,15 @@ Functions inlined into another (``jit.device``) count as the one they are inline
 ``jit.function`` is its own line. Needs Linux ``perf`` (perf_event_paranoid <= 2 for one's
 own processes).
 
+``--annotate NAME`` also shows where inside one compiled function (e.g. ``path.shade``)
+the samples fall: it copies the function's machine code out of this process, disassembles
+it with ``objdump`` and prints the instructions with the most samples, each after the
+instructions before it, with the functions its calls go to named (numba compiles without
+debug information, so the listing is machine code, not source lines).
+
 Run: python benchmarks/profile_kernels.py [--materials file|principled|textured]
                                           [--samples N] [--renders K] [--top T]
+                                          [--annotate NAME [--context C]]
 """
 from __future__ import annotations
 
@@ -33,9 +40,9 @@ import bench_cornell
 from mcengine import samplers
 
 
-def write_perf_map() -> int:
+def write_perf_map() -> dict:
     """Write /tmp/perf-<pid>.map for every function numba compiled in this process; returns
-    how many symbols it names."""
+    {address: (symbol, size)} of what it names."""
     from numba.core.registry import CPUDispatcher
 
     symbols = {}
@@ -55,11 +62,60 @@ def write_perf_map() -> int:
                 if address:
                     symbols.setdefault(address, fn.name)
     addresses = sorted(symbols)
+    table = {}
     with open(f"/tmp/perf-{os.getpid()}.map", "w") as fh:
         for k, address in enumerate(addresses):
             gap = addresses[k + 1] - address if k + 1 < len(addresses) else 1 << 16
-            fh.write(f"{address:x} {min(gap, 1 << 24):x} {symbols[address]}\n")
-    return len(addresses)
+            table[address] = (symbols[address], min(gap, 1 << 24))
+            fh.write(f"{address:x} {table[address][1]:x} {symbols[address]}\n")
+    return table
+
+
+def annotate(data: Path, table: dict, name: str, top: int, context: int) -> None:
+    """Print the instructions of the compiled function ``name`` (a short name such as
+    'path.shade', matched at the end) with the most samples in ``data``."""
+    import ctypes
+
+    matches = [(a, s, n) for a, (s, n) in table.items() if short_name(s).endswith(name)]
+    if not matches:
+        print(f"annotate: no compiled function named {name!r}")
+        return
+    address, symbol, size = max(matches, key=lambda m: m[2])
+    counts = collections.Counter()
+    script = subprocess.run(["perf", "script", "-i", str(data), "-F", "ip"],
+                            capture_output=True, text=True).stdout
+    ips = [int(word, 16) for word in script.split()]
+    for ip in ips:
+        if address <= ip < address + size:
+            counts[ip] += 1
+    inside = sum(counts.values())
+    with tempfile.NamedTemporaryFile(suffix=".bin") as code:
+        code.write(ctypes.string_at(address, size))
+        code.flush()
+        listing = subprocess.run(["objdump", "-D", "-b", "binary", "-m", "i386:x86-64",
+                                  "--no-show-raw-insn", f"--adjust-vma={address:#x}", code.name],
+                                 capture_output=True, text=True).stdout
+    names = {a: short_name(s) for a, (s, _) in table.items()}
+    rows = []
+    for line in listing.splitlines():
+        m = re.match(r"\s*([0-9a-f]+):\s*(.*)", line)
+        if not m:
+            continue
+        insn = m.group(2).strip()
+        # numba calls through a register loaded with the target's address: name both.
+        target = re.search(r"(?:call|movabs)\s+\$?0x([0-9a-f]+)", insn)
+        if target and int(target.group(1), 16) in names:
+            insn += f"    <{names[int(target.group(1), 16)]}>"
+        rows.append((int(m.group(1), 16), insn))
+    index = {a: i for i, (a, _) in enumerate(rows)}
+    print(f"\n{short_name(symbol)}: {size} bytes of code, {inside} of {len(ips)} samples "
+          f"({100.0 * inside / max(len(ips), 1):.1f} %); its {top} instructions with most samples:")
+    for ip, n in counts.most_common(top):
+        print(f"-- {100.0 * n / max(inside, 1):5.2f} % of the function's samples at +{ip - address:#x}")
+        i = index.get(ip)
+        for a, insn in rows[max(i - context, 0):i + 1] if i is not None else []:
+            mark = f"{counts[a]:5d}" if counts.get(a) else "     "
+            print(f"   {mark} +{a - address:#07x}  {insn}")
 
 
 def short_name(symbol: str) -> str:
@@ -69,7 +125,9 @@ def short_name(symbol: str) -> str:
         return symbol
     parts, rest = [], m.group(1)
     while rest:
-        n = re.match(r"\d+", rest).group(0)
+        n = re.match(r"\d*", rest).group(0)
+        if not n:
+            return symbol
         parts.append(rest[len(n):len(n) + int(n)])
         rest = rest[len(n) + int(n):]
     return ".".join(parts)
@@ -82,6 +140,10 @@ def main(argv=None) -> int:
     ap.add_argument("--resolution", type=int, default=256)
     ap.add_argument("--renders", type=int, default=2)
     ap.add_argument("--top", type=int, default=20)
+    ap.add_argument("--annotate", metavar="NAME",
+                    help="also show the hottest instructions of this compiled function")
+    ap.add_argument("--context", type=int, default=6,
+                    help="instructions shown before each hot one (with --annotate)")
     args = ap.parse_args(argv)
     if shutil.which("perf") is None:
         print("profile_kernels: Linux 'perf' is not installed", file=sys.stderr)
@@ -106,7 +168,8 @@ def main(argv=None) -> int:
                             resolution=(args.resolution, args.resolution))
 
     render(1)
-    count = write_perf_map()
+    table = write_perf_map()
+    count = len(table)
     with tempfile.TemporaryDirectory(prefix="mcengine_perf_") as folder:
         data = Path(folder) / "perf.data"
         recorder = subprocess.Popen(["perf", "record", "-q", "-F", "499", "-o", str(data),
@@ -119,6 +182,8 @@ def main(argv=None) -> int:
         report = subprocess.run(["perf", "report", "-i", str(data), "--no-children", "--stdio",
                                  "-g", "none", "--sort", "dso,sym", "--field-separator", "|"],
                                 capture_output=True, text=True).stdout
+        if args.annotate:
+            annotate(data, table, args.annotate, args.top, args.context)
     shares = collections.Counter()
     for line in report.splitlines():
         fields = line.split("|")

@@ -92,6 +92,7 @@ from .state import (
     move_path,
 )
 from .surface import hit_distance, past_self_hit, surface_point
+from .svm import OBJ_HOLDOUT
 
 _K_LIGHT_PATH = np.uint64(0x5851F42D4C957F2D)
 # The shutter time of every light path: light tracing is off where anything moves (``prepare``).
@@ -274,7 +275,10 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
         vertex = st.bounce[i] + 1                      # this vertex: x_(k - vertex + 1)
 
         # -- join this vertex to the camera: it is x1 of a path E x1 ... xk L ------------------
-        if caustic and vertex - 1 <= max_bounce:
+        # A holdout object keeps only its transparent closure for the camera (path.py), which
+        # has nothing to join: the film there is cleared, not lit.
+        if (caustic and vertex - 1 <= max_bounce
+                and not sc.tex.objects[sc.tex.tri_object[p], OBJ_HOLDOUT] > 0.0):
             view = camera_sees(cam, hx, hy, hz)
             if view.ok and in_film(table, x0, y0, rw, rh, view.rx, view.ry):
                 wcx, wcy, wcz = view.wx, view.wy, view.wz

@@ -52,6 +52,9 @@ SCENES = (
     "attribute_vertex_colors",
     "texture_suzanne_maps",
     "world_hdri_interior",
+    "material_thin_film",
+    "holdout_objects",
+    "world_sky",
 )
 
 

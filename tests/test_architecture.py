@@ -7,6 +7,7 @@
   ``mcengine_blender`` in ``addon/``), counting imports inside functions too.
 * The integrator vocabulary (names and Blender enum identifiers) is written in
   ``mcengine/integrators.py`` only.
+* Every scene generator in ``blend_scenes/`` is one that ``make_all.py`` builds.
 """
 from __future__ import annotations
 
@@ -142,3 +143,15 @@ def test_importing_the_core_loads_no_blender_module():
             "print(sorted(m for m in ('bpy', 'mathutils') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_make_all_builds_every_scene():
+    """``blend_scenes/make_all.py`` lists every generator script there (holdout_objects and
+    material_thin_film were missing from it for a day)."""
+    import re
+
+    folder = REPO / "blend_scenes"
+    listed = re.findall(r'^    "(\w+)",$', (folder / "make_all.py").read_text(), re.M)
+    scripts = {p.stem for p in folder.glob("*.py")
+               if not p.stem.startswith("_") and p.stem not in ("make_all", "render_cycles")}
+    assert sorted(listed) == sorted(scripts)

@@ -32,6 +32,7 @@ import numpy as np
 from .kernels.background import bake_background
 from .kernels.state import CFG_SIZE, CFG_WORLD_SHADER, alloc_scratch
 from .kernels.svm.data import IMG_CHANNELS, IMG_FLOAT, IMG_HEIGHT, IMG_OFFSET, IMG_WIDTH
+from .sky import node_image
 
 DEFAULT_MAP = (1024, 512)     # Automatic, without an Environment Texture
 
@@ -95,7 +96,7 @@ def _digest(sc, world, slots, registers, size) -> bytes:
              sc.svm_regs[int(registers[0]):int(registers[1])], sc.world]
     if any(n.type in _VIEW_NODES for n in world.nodes):
         parts += [sc.camera, sc.tex.objects]
-    for name in sorted({str(n.props.get("image", "")) for n in world.nodes} & set(slots)):
+    for name in sorted({node_image(n) for n in world.nodes} & set(slots)):
         row = sc.tex.images[slots[name]]
         pool = sc.tex.pixf if row[IMG_FLOAT] else sc.tex.pix8
         count = int(row[IMG_WIDTH] * row[IMG_HEIGHT] * row[IMG_CHANNELS])

@@ -79,6 +79,7 @@ from .kernels.svm import (
 from .passes import kernel_data, motion_corners, world_to_raster
 from .scene import DEFAULT_TERMINATOR_OFFSETS, SceneDescription
 from .shaders import AttributeLayout, ShaderTable
+from .sky import sky_images, sun_guide
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
@@ -121,7 +122,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
 
     layout, attr = pack_attributes(g)
-    images = ImageTable(scene.images)
+    images = ImageTable({**scene.images, **sky_images(scene)})
     shaders = ShaderTable(scene.materials + [scene.world.material()], layout, images.slots)
     world = len(scene.materials)            # the world's program follows the materials'
     start, end = shaders.ranges[world]
@@ -145,7 +146,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
                         objects=pack_objects(g), camera=camera, images=images.info,
                         pix8=images.pix8, pixf=images.pixf),
         motion=pack_motion(g, scene.motion_blur.objects if scene.motion_blur else []),
-        bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)))
+        bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)), bg_sun=np.zeros(5))
 
     # The world as a light: its importance map, when its radiance varies.
     world_importance = world_power = 0.0
@@ -153,8 +154,13 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     if size is not None:
         marginal, conditional, mean = world_map(sc, scene.world, images.slots,
                                                 shaders.register_ranges[world], size)
+        # A Sky Texture's sun: a cone sampled beside the map, and all of the world's samples
+        # when the map saw nothing (a sun too small for its texel centres in a black sky).
+        sun, sun_mean = sun_guide(scene.world)
+        if mean <= 0.0 and sun[4] > 0.0:
+            sun[4], mean = 1.0, sun_mean
         if mean > 0.0:
-            sc = sc._replace(bg_marginal=marginal, bg_conditional=conditional)
+            sc = sc._replace(bg_marginal=marginal, bg_conditional=conditional, bg_sun=sun)
             world_importance = math.pi * mean                     # irradiance, as a sun's
             world_power = world_importance * math.pi * scene_radius ** 2
 

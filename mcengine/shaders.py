@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import sky
 from .kernels.camera import CAMERA_PARAMS
 from .kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
 from .kernels.state import (
@@ -413,12 +414,16 @@ class _Compiler:
 
     def image_inputs(self, node, spec, values) -> list:
         """The image an image node reads, found by name (-1: none, magenta), and whether its
-        Alpha output is used."""
+        Alpha output is used; a Sky Texture's sun and horizon (``sky.node_parameters``)."""
         names = [s.name for s in spec.inputs]
-        slot = self.images.get(str(node.props.get("image", "")), -1)
+        slot = self.images.get(sky.node_image(node), -1)
         values[names.index("prop:image")] = Value(FLOAT, (float(slot),))
-        linked = 1.0 if self.is_linked(node, "Alpha") else 0.0
-        values[names.index("prop:alpha_linked")] = Value(FLOAT, (linked,))
+        if "prop:alpha_linked" in names:
+            linked = 1.0 if self.is_linked(node, "Alpha") else 0.0
+            values[names.index("prop:alpha_linked")] = Value(FLOAT, (linked,))
+        if node.type == "TexSky":
+            for name, value in sky.node_parameters(node.props).items():
+                values[names.index("prop:" + name)] = Value(FLOAT, (float(value),))
         return values
 
     def is_linked(self, node, output: str) -> bool:

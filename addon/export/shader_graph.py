@@ -28,6 +28,7 @@ import numpy as np
 
 from mcengine.kernels.svm.nodes import NODES, RAMP_TABLE_SIZE, SHADER_ROUTING
 from mcengine.scene import Link, ShaderNode
+from mcengine.sky import SKY_TYPES
 
 __all__ = ["GraphReader", "label", "node_type", "source", "SPECIAL_PROPS"]
 
@@ -194,10 +195,13 @@ class GraphReader:
         target = out.node
         kind = node_type(target)
         spec = NODES.get(kind)
+        feature = f"{kind} node"
+        if kind == "TexSky" and target.sky_type not in SKY_TYPES:
+            spec, feature = None, f"Sky Texture type {target.sky_type}"
         if spec is None or spec.outputs and spec.outputs[0].type == "shader":
             what = "shader output" if spec is not None else "node"
             self.note(f"{label(target)} into {label(node)} '{sock.name}'",
-                      "shader nodes" if spec is not None else f"{kind} node",
+                      "shader nodes" if spec is not None else feature,
                       f"unlinked value of {label(node)} '{sock.name}' used"
                       + ("" if spec is None else f" ({what} into a value)"))
             return _constant(getattr(sock, "default_value", None), socket.type)

@@ -15,6 +15,14 @@ pdf, p_uv / (2 pi^2 sin theta) with theta of the continuous v;
 ``background_pdf`` gives the same pdf for any direction, for the MIS weight of a
 ray that escapes.  The world's radiance itself always comes from its shader
 (``shading.world_radiance``), never from the map.
+
+A Sky Texture's sun disc is far smaller than a texel of the map, which sees it only
+where a texel's centre falls inside it: the rest of the disc would be found by BSDF
+rays alone, as rare, bright fireflies.  As Cycles' sun guiding, a share of the world's
+samples then goes to the sun's cone instead (``bg_sun``, set by ``mcengine.packing``
+from ``mcengine.sky.sun_guide``), drawn uniformly in it: ``sample_world`` and
+``world_pdf`` are the mixture of the cone and the map.  The map keeps the disc's texels
+(Cycles leaves the sun out of its bake), which changes only how the samples are shared.
 """
 from __future__ import annotations
 
@@ -24,6 +32,7 @@ import numpy as np
 
 from ..jit import device, kernel
 from .light_sampling import pick_light
+from .sampling import orthonormal_basis
 from .state import CFG_WORLD_SHADER
 from .svm import ShadingData, eval_shader
 from .svm.image_nodes import direction_to_equirectangular
@@ -94,6 +103,47 @@ def sample_background(marginal, conditional, u1, u2):
     dx, dy, dz = equirectangular_direction(u, v)
     pdf = width * h * cwidth * w / (2.0 * math.pi * math.pi * s)
     return dx, dy, dz, pdf
+
+
+@device
+def sample_world(sc, u1, u2):
+    """A direction towards the world: from the sun cone ``sc.bg_sun`` (uniformly, for its
+    share of the samples) or from the map; (x, y, z, solid-angle pdf of the mixture)."""
+    sun = sc.bg_sun
+    share = sun[4]
+    if share > 0.0 and u1 < share:
+        u1 = u1 / share
+        cos_max = sun[3]
+        cos_t = 1.0 - u1 * (1.0 - cos_max)
+        sin_t = math.sqrt(max(1.0 - cos_t * cos_t, 0.0))
+        phi = 2.0 * math.pi * u2
+        tx, ty, tz, bx, by, bz = orthonormal_basis(sun[0], sun[1], sun[2])
+        lx, ly = sin_t * math.cos(phi), sin_t * math.sin(phi)
+        dx = lx * tx + ly * bx + cos_t * sun[0]
+        dy = lx * ty + ly * by + cos_t * sun[1]
+        dz = lx * tz + ly * bz + cos_t * sun[2]
+    else:
+        if share > 0.0:
+            u1 = min((u1 - share) / (1.0 - share), 1.0)
+        dx, dy, dz, pdf = sample_background(sc.bg_marginal, sc.bg_conditional, u1, u2)
+        if pdf <= 0.0:
+            return dx, dy, dz, 0.0
+    return dx, dy, dz, world_pdf(sc, dx, dy, dz)
+
+
+@device
+def world_pdf(sc, dx, dy, dz):
+    """Solid-angle pdf with which ``sample_world`` draws direction d (unit)."""
+    sun = sc.bg_sun
+    share = sun[4]
+    pdf = background_pdf(sc.bg_marginal, sc.bg_conditional, dx, dy, dz)
+    if share <= 0.0:
+        return pdf
+    pdf *= 1.0 - share
+    cos_max = sun[3]
+    if dx * sun[0] + dy * sun[1] + dz * sun[2] >= cos_max:
+        pdf += share / (2.0 * math.pi * (1.0 - cos_max))
+    return pdf
 
 
 @device

@@ -34,7 +34,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device, kernel
-from .background import background_pdf, sample_background, world_radiance
+from .background import sample_world, world_pdf, world_radiance
 from .closures import (
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
@@ -292,8 +292,7 @@ def light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, d
         elif pmf_mode == PMF_GLOBAL:
             pick = fcfg[FCFG_WORLD_PMF]
         if pick > 0.0 and not (flags & PF_MIS_SKIP):
-            w = power_heuristic(mis_pdf, pick * background_pdf(sc.bg_marginal, sc.bg_conditional,
-                                                               dx, dy, dz))
+            w = power_heuristic(mis_pdf, pick * world_pdf(sc, dx, dy, dz))
             wr, wg, wb = wr * w, wg * w, wb * w
         add_light(out, row, beta[i, 0] * wr, beta[i, 1] * wg, beta[i, 2] * wb, direct, fcfg, stats)
     if transparent_film:
@@ -425,10 +424,10 @@ def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, sp, flags, 
 # -- 5. next-event estimation -----------------------------------------------------------------
 @device
 def world_light_sample(sc, cfg, scratch, pmf, u1, u2):
-    """A direction towards the world drawn from its importance map (picked with
-    probability ``pmf``), as a :class:`LightSample` (radiance from the world's shader,
+    """A direction towards the world drawn from its importance map and sun cone (picked
+    with probability ``pmf``), as a :class:`LightSample` (radiance from the world's shader,
     evaluated as for a light: no ray-type flags)."""
-    wix, wiy, wiz, pdf = sample_background(sc.bg_marginal, sc.bg_conditional, u1, u2)
+    wix, wiy, wiz, pdf = sample_world(sc, u1, u2)
     pdf_l = pmf * pdf
     if pdf_l <= 0.0:
         return LightSample(0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, 0,

@@ -103,6 +103,8 @@ SceneData = namedtuple("SceneData", [
     "motion",        # kernels.motion.MotionData: the objects that move during the shutter
     "bg_marginal",   # (H + 1,) f64   the world's importance map: CDF over its rows
     "bg_conditional",  # (H, W + 1) f64  CDF over the columns of each row (kernels.background)
+    "bg_sun",        # (5,) f64     a sun cone sampled beside the map: direction, cos of its
+                     #              half angle, the share of world samples it gets (0: none)
 ])
 
 # Material flags (mat_flags).

@@ -164,12 +164,20 @@ def test_world_camera_visibility(scene, fake_session):
     assert export_scene(fake_session).world.visible_camera is False
 
 
-def test_world_texture_uses_the_unlinked_value(scene, fake_session):
+def test_sky_texture_types_other_than_multiple_scattering_use_the_unlinked_value(scene, fake_session):
+    """The default Sky Texture (Multiple Scattering) is exported with its settings; the other
+    types are named in the warning and their consumer keeps its unlinked value."""
     world = world_with_background((0.1, 0.2, 0.3), 1.0)
     sky = world.node_tree.nodes.new("ShaderNodeTexSky")
+    sky.sun_elevation = 0.3
     world.node_tree.links.new(sky.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
     desc = export_scene(fake_session)
-    assert desc.world.color == pytest.approx((0.1, 0.2, 0.3))
+    exported = [n for n in desc.world.nodes if n.type == "TexSky"]
+    assert len(exported) == 1 and exported[0].props["sun_elevation"] == pytest.approx(0.3)
+    assert not [w for w in desc.warnings if w.startswith("world")]
+    sky.sky_type = "PREETHAM"
+    desc = export_scene(fake_session)
+    assert not [n for n in desc.world.nodes if n.type == "TexSky"]
     assert [w for w in desc.warnings if w.startswith("world")] == [
         "world 'Sky': Sky Texture into Background 'Color' not supported yet; "
         "unlinked value of Background 'Color' used"]

@@ -16,13 +16,15 @@ the bottom.  Lookups, as Cycles' CPU sampler makes them:
 
 Image Texture projects its vector Flat (x, y), on a Sphere or a Tube, or Box (three
 planar lookups blended by the object-space normal); Environment Texture maps a direction
-to the equirectangular or mirror-ball image.
+to the equirectangular or mirror-ball image; Sky Texture reads the sky image that
+``mcengine.sky`` precomputes and adds the sun disc.
 """
 from __future__ import annotations
 
 import math
 
 from ...jit import device, function
+from ..colorspace import XYZ_TO_RGB
 from .data import (
     IMG_CHANNELS,
     IMG_FLAGS,
@@ -64,6 +66,18 @@ _TE_IMAGE = _TE["prop:image"]
 _TE_INTERPOLATION = _TE["prop:interpolation"]
 _TE_PROJECTION = _TE["prop:projection"]
 _TE_ALPHA_LINKED = _TE["prop:alpha_linked"]
+_TEX_SKY = NODES["TexSky"].code
+_TS = OFFSETS["TexSky"]
+_TS_VECTOR = _TS["Vector"]
+_TS_IMAGE = _TS["prop:image"]
+_TS_ELEVATION = _TS["prop:sky_elevation"]
+_TS_ROTATION = _TS["prop:sky_rotation"]
+_TS_DIAMETER = _TS["prop:sky_diameter"]
+_TS_INTENSITY = _TS["prop:sun_intensity"]
+_TS_HORIZON = _TS["prop:sky_horizon"]
+_TS_BOTTOM = _TS["prop:sky_bottom_x"]     # x, y, z follow
+_TS_TOP = _TS["prop:sky_top_x"]
+_XYZ_TO_RGB = XYZ_TO_RGB
 
 # Texture coordinates beyond this many texels are read at 0 (their integer index would
 # overflow; Cycles' own result there is undefined).
@@ -77,6 +91,8 @@ def eval_image_node(code, regs, b, c, sd, tex):
         image_texture_node(regs, b, c, sd, tex)
     elif code == _TEX_ENVIRONMENT:
         environment_texture_node(regs, b, c, tex)
+    elif code == _TEX_SKY:
+        sky_texture_node(regs, b, c, tex)
 
 
 # -- lookups -----------------------------------------------------------------------------------
@@ -352,3 +368,49 @@ def environment_texture_node(regs, b, c, tex):
                                 regs[b + _TE_ALPHA_LINKED] != 0.0)
     regs[c], regs[c + 1], regs[c + 2] = r, g, bb
     regs[c + 3] = a
+
+
+# -- Sky Texture ---------------------------------------------------------------------------------
+@device
+def sky_texture_node(regs, b, c, tex):
+    """Cycles' sky_radiance_nishita: the sun disc where the direction is within half its
+    angular diameter of the sun and above the horizon (the disc's XYZ interpolated by
+    elevation from its bottom to its top, times the intensity and a limb darkening
+    1 - 0.6 (1 - sqrt(1 - (angle / half)^2))), plus the sky image (mcengine.sky: XYZ, Linear,
+    Extend) at the direction's azimuth from the sun and its elevation, square-root spaced;
+    XYZ to the working space, negative values clamped to 0."""
+    v = b + _TS_VECTOR
+    x, y, z = regs[v], regs[v + 1], regs[v + 2]
+    ln = math.sqrt(x * x + y * y + z * z)
+    if ln > 0.0:
+        x, y, z = x / ln, y / ln, z / ln
+    elevation = math.pi / 2 - math.acos(min(max(z, -1.0), 1.0))
+    sun_elevation, rotation = regs[b + _TS_ELEVATION], regs[b + _TS_ROTATION]
+    diameter = regs[b + _TS_DIAMETER]
+    cx = cy = cz = 0.0
+    if diameter >= 0.0:
+        # The sun's direction: spherical (theta, phi) = (elevation - pi/2, rotation - pi/2).
+        st, sp = sun_elevation - math.pi / 2, rotation - math.pi / 2
+        sx, sy, sz = math.sin(st) * math.cos(sp), math.sin(st) * math.sin(sp), math.cos(st)
+        dx, dy, dz = x - sx, y - sy, z - sz
+        ax, ay, az = x + sx, y + sy, z + sz
+        angle = 2.0 * math.atan2(math.sqrt(dx * dx + dy * dy + dz * dz),
+                                 math.sqrt(ax * ax + ay * ay + az * az))
+        half = 0.5 * diameter
+        if angle < half and elevation > regs[b + _TS_HORIZON]:
+            t = (elevation - sun_elevation) / diameter + 0.5
+            q = angle / half
+            k = regs[b + _TS_INTENSITY] * (1.0 - 0.6 * (1.0 - math.sqrt(1.0 - q * q)))
+            cx = (regs[b + _TS_BOTTOM] + (regs[b + _TS_TOP] - regs[b + _TS_BOTTOM]) * t) * k
+            cy = (regs[b + _TS_BOTTOM + 1] + (regs[b + _TS_TOP + 1] - regs[b + _TS_BOTTOM + 1]) * t) * k
+            cz = (regs[b + _TS_BOTTOM + 2] + (regs[b + _TS_TOP + 2] - regs[b + _TS_BOTTOM + 2]) * t) * k
+    u = (-math.atan2(y, x) - math.pi / 2 + rotation) * (0.5 / math.pi)
+    u -= math.floor(u)
+    vv = math.copysign(math.sqrt(abs(elevation) * (2.0 / math.pi)), elevation) * 0.5 + 0.5
+    sx_, sy_, sz_, _ = image_texture(tex, int(regs[b + _TS_IMAGE]), u, vv, INTERP_LINEAR,
+                                     EXT_EXTEND, False)
+    cx, cy, cz = cx + sx_, cy + sy_, cz + sz_
+    m = _XYZ_TO_RGB
+    regs[c] = max(m[0, 0] * cx + m[0, 1] * cy + m[0, 2] * cz, 0.0)
+    regs[c + 1] = max(m[1, 0] * cx + m[1, 1] * cy + m[1, 2] * cz, 0.0)
+    regs[c + 2] = max(m[2, 0] * cx + m[2, 1] * cy + m[2, 2] * cz, 0.0)

@@ -467,6 +467,16 @@ VALUE_NODES = {
                                      _p("interpolation", INTERP_LINEAR),
                                      _p("projection", PROJ_EQUIRECTANGULAR), _p("alpha_linked", 0)),
                                (_c("Color", (0, 0, 0)), _f("Alpha", 0.0)), False),
+    # Sky Texture (Multiple Scattering): the precomputed sky image ("prop:image", XYZ) and
+    # the sun disc; its "sky_*" properties are what mcengine.sky.node_parameters derives from
+    # the node's settings (the sun's wrapped elevation and rotation, its angular diameter or
+    # -1 without a disc, the horizon's elevation, the disc's XYZ at its bottom and top).
+    "TexSky": NodeSpec(452, (_v("Vector", GENERATED), _p("image", -1), _p("sky_elevation", 0.0),
+                             _p("sky_rotation", 0.0), _p("sky_diameter", -1.0),
+                             _p("sun_intensity", 1.0), _p("sky_horizon", 0.0),
+                             _p("sky_bottom_x", 0.0), _p("sky_bottom_y", 0.0), _p("sky_bottom_z", 0.0),
+                             _p("sky_top_x", 0.0), _p("sky_top_y", 0.0), _p("sky_top_z", 0.0)),
+                       (_c("Color", (0, 0, 0)),), False),
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
@@ -489,7 +499,7 @@ VALUE_NODES = {
 }
 # The Bump node's three heights: at the point, at the point moved along dPdx and along dPdy.
 BUMP_HEIGHTS = ("Height", "Height_dx", "Height_dy")
-IMAGE_NODES = ("TexImage", "TexEnvironment")     # nodes that read an image (``prop:image``)
+IMAGE_NODES = ("TexImage", "TexEnvironment", "TexSky")     # nodes that read an image (``prop:image``)
 
 # Name of the per-corner tangent attribute of a UV map ("" is the default UV map).
 TANGENT_PREFIX = "tangent:"

@@ -130,6 +130,7 @@ def _betainc_cf(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     f = np.ones_like(x)
     c = np.ones_like(x)
     d = np.zeros_like(x)
+    active = np.ones(np.shape(x), bool)     # elements whose fraction has not converged yet
     for m in range(_CF_MAX_ITER):
         # terms d_{2m} (from m = 1 on) and d_{2m+1}
         odd = -(a + m) * (a + b + m) * x / ((a + 2 * m) * (a + 2 * m + 1))
@@ -142,8 +143,12 @@ def _betainc_cf(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
             c = 1.0 + coef / c
             c = np.where(np.abs(c) > _CF_TINY, c, _CF_TINY)
             delta = c * d
-            f *= delta
-        if np.all(np.abs(delta - 1.0) < _CF_TOLERANCE):
+            f = np.where(active, f * delta, f)
+        # An element stops once it has converged: its later steps only jitter by rounding,
+        # which could keep a slower element's iteration from ever seeing all of them below
+        # the tolerance at once.
+        active &= ~(np.abs(delta - 1.0) < _CF_TOLERANCE)
+        if not active.any():
             return 1.0 / f
     raise ArithmeticError("incomplete beta continued fraction did not converge")
 

@@ -35,7 +35,7 @@ import numpy as np
 
 from .scene import Image, SceneDescription
 
-__all__ = ["SKY_TYPES", "earth_intersection_angle", "image_name", "node_image", "node_parameters",
+__all__ = ["SKY_TYPES", "disc_solid_angle", "earth_intersection_angle", "image_name", "node_image", "node_parameters",
            "single_scattering_image", "single_scattering_sun_xyz", "sky_image", "sky_images",
            "sun_disc_xyz", "sun_guide", "sun_position"]
 
@@ -255,12 +255,23 @@ def sky_image(sun_elevation, altitude, air, aerosol, ozone, size=IMAGE_SIZE):
     return image
 
 
+def disc_solid_angle(angular_diameter) -> float:
+    """Solid angle of the sun disc, 2 pi (1 - cos(diameter / 2)), in single precision as
+    Cycles computes it: for a disc this small 1 - cos keeps only a few digits (the default
+    0.545 deg disc's is 0.13 % too large, 0.0095 rad's 0.14 % too small), and the disc's
+    radiance is its irradiance over it (measured: a plane under a 0.0095 rad sun renders
+    0.14 % brighter in Cycles than the exact integral)."""
+    f32 = np.float32
+    half = f32(angular_diameter) / f32(2.0)
+    return float(f32(2.0 * math.pi) * (f32(1.0) - f32(math.cos(float(half)))))
+
+
 def sun_disc_xyz(sun_elevation, angular_diameter, altitude, air, aerosol, ozone):
     """XYZ radiance of the sun disc at its lowest and highest points: the sun's irradiance
     through the atmosphere there over the disc's solid angle."""
     densities = (float(air), float(aerosol), float(ozone))
     half = float(angular_diameter) / 2.0
-    solid_angle = 2.0 * math.pi * (1.0 - math.cos(half))
+    solid_angle = disc_solid_angle(angular_diameter)
     normalized = _altitude_km(altitude) / ATMOSPHERE_THICKNESS
     out = []
     for elevation in (float(sun_elevation) - half, float(sun_elevation) + half):
@@ -426,7 +437,7 @@ def single_scattering_sun_xyz(sun_elevation, angular_diameter, altitude, air, ae
     """XYZ radiance of the Single Scattering sun disc at its lowest and highest points
     (through Rayleigh and Mie only; black when the whole disc is below the horizon)."""
     half = float(angular_diameter) / 2.0
-    solid_angle = 2.0 * math.pi * (1.0 - math.cos(half))
+    solid_angle = disc_solid_angle(angular_diameter)
     bottom, top = max(sun_elevation - half, 0.0), max(sun_elevation + half, 0.0)
     if top <= 0.0:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)

@@ -4,7 +4,9 @@ Wrong renders are MC Engine renders of a deliberately altered scene compared
 with Cycles on the original; each must give "differ", in the right place and
 direction.  Right renders are Cycles against Cycles with other seeds; every
 scene must give "agree" (this is the false-alarm side of the test, with the
-same alpha as the suite).
+same alpha as the suite): one scene of each kind in the default run, every
+scene with ``-m slow`` (two more Cycles renders a scene, about 2.5 min of the
+default run's time for all of them).
 """
 import bpy
 import numpy as np
@@ -190,7 +192,20 @@ def test_motion_blur_errors_are_caught(renders, name, what, edit):
     assert result.agreement.differing_blocks()
 
 
-@pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)
+# The scenes whose Cycles-against-Cycles check runs by default: one of each kind (the
+# others are marked slow).
+SELF_CHECK_DEFAULT = {"cornell_box", "light_area", "light_sun", "caustics", "camera_dof",
+                      "material_principled", "material_rough_glass", "texture_suzanne_maps",
+                      "motion_deform", "holdout_objects", "world_hdri_interior", "world_sky"}
+
+
+def test_the_default_self_checks_name_scenes():
+    assert SELF_CHECK_DEFAULT <= {p.stem for p in SCENES}
+
+
+@pytest.mark.parametrize("blend", [
+    pytest.param(p, marks=() if p.stem in SELF_CHECK_DEFAULT else pytest.mark.slow) for p in SCENES],
+    ids=lambda p: p.stem)
 def test_cycles_agrees_with_itself_across_seeds(blend, renders):
     name = blend.stem
     options = options_for(name)

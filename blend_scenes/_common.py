@@ -623,6 +623,16 @@ def add_stage(scene):
     return {"floor": floor, "cube": cube, "sphere": sphere, "block": block, "camera": camera}
 
 
+def add_horizon_stage(scene):
+    """The stage (:func:`add_stage`) seen from a camera lowered to z = 1.8, so that the world
+    above the horizon fills the top of the frame (the world scenes)."""
+    stage = add_stage(scene)
+    camera = stage["camera"]
+    camera.location = (0.0, -6.0, 1.8)
+    look_at(camera, (0.0, 0.0, 0.7))
+    return stage
+
+
 # --------------------------------------------------------------------------
 # Saving
 # --------------------------------------------------------------------------

@@ -45,10 +45,7 @@ def sky_pixels():
 def build(scene):
     env = c.environment_world(scene, strength=STRENGTH, map_resolution=1024)
     env.image = c.save_texture("sky_small_sun.exr", sky_pixels(), float_buffer=True)
-    stage = c.add_stage(scene)
-    camera = stage["camera"]
-    camera.location = (0.0, -6.0, 1.8)
-    c.look_at(camera, (0.0, 0.0, 0.7))
+    c.add_horizon_stage(scene)
 
 
 if __name__ == "__main__":

@@ -27,10 +27,7 @@ def build(scene):
                         sun_rotation=math.radians(250.0))
     tree.links.new(sky.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     c.set_bounces(scene, 4, 4)
-    stage = c.add_stage(scene)
-    camera = stage["camera"]
-    camera.location = (0.0, -6.0, 1.8)
-    c.look_at(camera, (0.0, 0.0, 0.7))
+    c.add_horizon_stage(scene)
 
 
 if __name__ == "__main__":

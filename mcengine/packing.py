@@ -109,7 +109,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     verts = g.vertices.astype(np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
     if len(tris):
-        tri_area, tri_normal = _areas_and_normals(verts, tris)
+        tri_area, tri_normal = areas_and_normals(verts, tris)
         lo, hi = verts.min(axis=0), verts.max(axis=0)
     else:
         tri_area = np.zeros(0)
@@ -287,7 +287,7 @@ def pack_objects(g) -> np.ndarray:
     return out
 
 
-def _areas_and_normals(verts, tris, block: int = 1 << 16):
+def areas_and_normals(verts, tris, block: int = 1 << 16):
     """Area and unit geometric normal of every triangle, (T,) and (T, 3) float64.
 
     Computed in blocks of triangles: whole-array float64 temporaries (the corners

@@ -78,7 +78,9 @@ class Geometry:
 
     vertices        (V, 3) float32  vertex positions
     triangles       (T, 3) int32    vertex indices of each triangle
-    normals         (T, 3, 3) float32  shading normal at each corner (unit length)
+    normals         (T, 3, 3) float32  shading normal at each corner (unit length; after true
+                    displacement of a stretched object, the length its normal matrix gives
+                    them: ``displacement``)
     uvs             (T, 3, 2) float32  UV at each corner (zeros if the mesh has none)
     material_index  (T,) int32      index into ``SceneDescription.materials``
     object_index    (T,) int32      index into ``object_names`` (for messages)
@@ -270,8 +272,9 @@ class Material:
     ``use_bump_map_correction`` tilts glossy normals whose mirror direction
     would point into the surface (Cycles' material setting of that name).
     ``displacement`` is what the output's Displacement socket receives: with
-    ``displacement_method`` 'BUMP' (or 'BOTH', whose true displacement is not rendered)
-    it bumps the shading normal as Cycles' automatic bump does (``shaders``).
+    ``displacement_method`` 'BUMP' it bumps the shading normal as Cycles' automatic bump
+    does (``shaders``), with 'DISPLACEMENT' it moves the vertices of the material's triangles
+    (true displacement, ``displacement``), and 'BOTH' does both.
 
     A material without ``nodes`` is described by the shorthand fields, a sum of
     closures convenient for tests and tools, equivalent to the graph

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import accel_cache, blas, memory
+from . import accel_cache, blas, displacement, memory
 from . import passes as render_passes
 from .adaptive import Adaptive
 from .denoise import denoise
@@ -89,9 +89,10 @@ MIN_CHUNK_PATHS = 1 << 12     # below this, per-call overhead dominates
 class RenderStats:
     """What the render did and how long it took (seconds, counts)."""
 
-    time_pack: float = 0.0          # packing the scene for the kernels: tables, shaders, the
-                                    # world's map (a first run also compiles the shader
-                                    # evaluator, which packing runs once per material)
+    time_pack: float = 0.0          # packing the scene for the kernels: true displacement,
+                                    # tables, shaders, the world's map (a first run also
+                                    # compiles the shader evaluator, which packing runs once
+                                    # per material)
     time_bvh: float = 0.0
     time_kernels: float = 0.0       # compiling or loading the numba kernels
     time_render: float = 0.0        # tracing and shading, wall clock
@@ -300,7 +301,10 @@ class RenderSession:
                  batch_size: int | None = None, host_bytes_per_pixel: int = 0,
                  force_effects=()):
         blas.use_one_thread()          # numpy's small matrix calls: microseconds, not ms
-        self.scene = scene.validate()
+        # Truly displaced meshes move first: the packed tables and the BVH see them moved.
+        t0 = time.perf_counter()
+        scene = self.scene = displacement.displace(scene.validate())
+        time_displace = time.perf_counter() - t0
         self.threads = int(threads or default_threads())
         self.batch_size = int(batch_size or DEFAULT_BATCH)
         it = scene.integrator
@@ -308,7 +312,7 @@ class RenderSession:
         # The effects plan (``features``): what the scene calls for, as kernel flags.
         t0 = time.perf_counter()
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects)
-        self.stats.time_pack = time.perf_counter() - t0
+        self.stats.time_pack = time.perf_counter() - t0 + time_displace
         self.stats.texture_bytes = int(self.sc.tex.pix8.nbytes + self.sc.tex.pixf.nbytes)
         self.integrator = integrator_info(it.name)
         self.warnings = []             # what this integrator renders differently, in words

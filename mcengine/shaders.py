@@ -101,7 +101,7 @@ from .kernels.svm.nodes import (
 from .scene import Link, Material, SceneError, ShaderNode
 
 __all__ = ["AttributeLayout", "DEFAULT_COLOR_ATTRIBUTE", "GEOMETRY_ATTRIBUTES", "Program", "compile_material",
-           "ShaderTable"]
+           "compile_displacement", "truly_displaced", "ShaderTable"]
 
 # The name under which a mesh's default colour attribute (Blender's render colour) is also
 # stored: what a Color Attribute node with no name reads, as Cycles' ATTR_STD_VERTEX_COLOR.
@@ -110,9 +110,17 @@ DEFAULT_COLOR_ATTRIBUTE = ".default color"
 # (ATTR_STD_POINTINESS, ATTR_STD_RANDOM_PER_ISLAND): output -> the attribute's name, under
 # which the export stores what mcengine.mesh_attributes computes for the meshes that need it.
 GEOMETRY_ATTRIBUTES = {"Pointiness": ".pointiness", "Random Per Island": ".random per island"}
-# Displacement methods whose displacement Cycles turns into a bump ('BOTH' also displaces
-# the mesh, which is not rendered: warned at export).
+# Displacement methods whose displacement Cycles turns into a bump, and those that move the
+# mesh's vertices (true displacement, ``mcengine.displacement``): 'BOTH' does both.
 BUMP_METHODS = ("BUMP", "BOTH")
+TRUE_DISPLACEMENT_METHODS = ("DISPLACEMENT", "BOTH")
+# Per-corner attributes of truly displaced scenes: the object-space point before displacement
+# (what the Texture Coordinate's Generated output reads there, as Cycles' generated
+# attribute) and, from the export, each corner's object-space vertex normal and whether its
+# face is smooth (the direction of displacement and how normals are recomputed after it).
+UNDISPLACED_ATTRIBUTE = ".undisplaced"
+VERTEX_NORMAL_ATTRIBUTE = ".vertex normal"
+SMOOTH_ATTRIBUTE = ".smooth"
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
 # A closure's anisotropy input and the largest constant value at which the closure ignores
 # its tangent (kernels/svm/closure_nodes.py, as Cycles' svm_node_closure_bsdf): the implicit
@@ -188,6 +196,20 @@ def compile_material(material: Material, attributes: AttributeLayout | None = No
     return _Compiler(material, attributes or AttributeLayout(), base, images or {}).compile()
 
 
+def truly_displaced(material: Material) -> bool:
+    """Whether the material moves the vertices of its triangles (a linked Displacement, method
+    'DISPLACEMENT' or 'BOTH')."""
+    return (getattr(material, "displacement", None) is not None
+            and material.displacement_method in TRUE_DISPLACEMENT_METHODS)
+
+
+def compile_displacement(material: Material, attributes: AttributeLayout | None = None,
+                         base: int = 0, images: dict | None = None) -> tuple[Program, int]:
+    """The output's Displacement of a truly displaced material as value rows (no closures):
+    the program and the first of the three registers its vector ends in."""
+    return _Compiler(material, attributes or AttributeLayout(), base, images or {}).displacement()
+
+
 class _Compiler:
     def __init__(self, material: Material, attributes: AttributeLayout, base: int, images: dict):
         self.material = material
@@ -210,6 +232,11 @@ class _Compiler:
                 self.displacement_bump(displacement)
             self.shader(self.surface, NO_WEIGHT, False)
         return self.program
+
+    def displacement(self) -> tuple[Program, int]:
+        value = self.converted(self.output(self.material.displacement), VECTOR)
+        reg = value.reg if not value.constant else self.program.store(value.const)
+        return self.program, reg
 
     def displacement_bump(self, link: Link) -> None:
         """Cycles' automatic bump from the output's Displacement: a Bump node (Distance 1,
@@ -382,6 +409,10 @@ class _Compiler:
             values = self.attribute_inputs(node, spec, values)
         elif node.type in IMAGE_NODES:
             values = self.image_inputs(node, spec, values)
+        elif node.type == "TexCoord":
+            names = [s.name for s in spec.inputs]
+            offset = self.attributes.find(UNDISPLACED_ATTRIBUTE)[0]
+            values[names.index("prop:undisplaced")] = Value(FLOAT, (float(offset),))
         if spec.pure and all(v.constant for v in values):
             return self.fold(spec, values)
         base = self.block(spec.inputs, values)

@@ -11,7 +11,8 @@ It renders a few samples of one pixel of a tiny scene with each integrator
 (``warm_up_scene``: every kernel of the integrator runs), the default one first
 (every shader node and closure is compiled with the shader evaluator, whatever
 the scene uses), and one of a scene with what else a render may compile
-(``features_scene``: motion blur, a world and a mesh light whose radiance varies),
+(``features_scene``: motion blur, a world and a mesh light whose radiance varies, true
+displacement),
 then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core:
 once the shader evaluator, which every integrator calls, is in the cache, a second
 process (``python -m mcengine.warmup --only NAME...``) compiles the other
@@ -103,7 +104,7 @@ def features_scene() -> SceneDescription:
     radiance varies (its importance map is baked, ``kernels.background``), a square that
     emits a gradient (a mesh light whose emission varies: ``kernels.shading.emission_estimates``
     weighs it) and moves while the shutter is open (motion blur: ``kernels.motion``), above
-    the warm-up's floor."""
+    the warm-up's floor, which a texture displaces (``kernels.displace``)."""
     lamp = _FLOOR[:, ::-1] * 0.2 + (0.0, 0.0, 1.0)         # facing down
     gradient = [ShaderNode("TexGradient")]
     emission = Material(name="lamp", nodes=gradient + [ShaderNode("Emission", {"Color": Link(0, "Color")})],
@@ -117,10 +118,18 @@ def features_scene() -> SceneDescription:
     return SceneDescription(
         geometry=Geometry.from_triangles(np.concatenate([_FLOOR, lamp]), material_index=[0, 0, 1, 1],
                                          object_index=[0, 0, 1, 1], object_names=["floor", "lamp"]),
-        materials=[Material(), emission], world=world,
+        materials=[_displaced_material(), emission], world=world,
         motion_blur=MotionBlur(objects=[ObjectMotion(object=1, vertices=(6, 6), matrices=steps)]),
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),
         integrator=Integrator(samples=4))
+
+
+def _displaced_material() -> Material:
+    """Diffuse, displaced by a little of a gradient texture ('Displacement Only')."""
+    nodes = [ShaderNode("TexGradient"), ShaderNode("Displacement", {"Height": Link(0, "Fac"), "Scale": 0.01}),
+             ShaderNode("BsdfDiffuse")]
+    return Material(name="floor", nodes=nodes, surface=Link(2, "BSDF"), displacement=Link(1, "Displacement"),
+                    displacement_method="DISPLACEMENT")
 
 
 def _compile(steps) -> None:

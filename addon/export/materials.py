@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from mcengine.kernels.svm.nodes import Socket
 from mcengine.scene import Link, Material, ShaderNode
-from mcengine.shaders import GEOMETRY_ATTRIBUTES
+from mcengine.shaders import GEOMETRY_ATTRIBUTES, VERTEX_NORMAL_ATTRIBUTE, truly_displaced
 
 from .shader_graph import GraphReader, label, source
 
@@ -50,8 +50,11 @@ class MaterialTable:
     def attribute_names(self) -> set:
         """Names of the attributes the materials converted so far read: those of Attribute
         nodes, and those derived from the mesh that a Geometry node's output reads
-        (``GEOMETRY_ATTRIBUTES``)."""
+        (``GEOMETRY_ATTRIBUTES``); with true displacement, the vertex normals
+        (``VERTEX_NORMAL_ATTRIBUTE``)."""
         names = set()
+        if any(truly_displaced(m) for m in self.materials):
+            names.add(VERTEX_NORMAL_ATTRIBUTE)
         for m in self.materials:
             for node in m.nodes:
                 if node.type == "Attribute":
@@ -110,19 +113,22 @@ def convert_material(ctx, material) -> Material:
 
 
 def _displacement(graph, material, out):
-    """What the output's Displacement receives (a Link, else None), rendered as Cycles' bump
-    from displacement; true displacement (methods 'DISPLACEMENT' and 'BOTH') is warned."""
+    """What the output's Displacement receives (a Link, else None): Cycles' bump from
+    displacement (method 'BUMP'), true displacement of the mesh ('DISPLACEMENT',
+    ``mcengine.displacement``) or both ('BOTH').  On a displaced surface Cycles shows bumps
+    and normal maps the undisplaced point and normal, MC Engine the displaced ones: warned."""
     socket = out.inputs["Displacement"]
     src = linked_node(socket)
     if src is None:
         return None
     method = str(getattr(material, "displacement_method", "BUMP"))
-    if method == "DISPLACEMENT":
-        graph.note(f"true displacement ({label(src)})", "displacement", "the surface is not displaced")
-        return None
-    if method == "BOTH":
-        graph.note(f"true displacement ({label(src)})", "displacement",
-                   "the surface is not displaced, only bumped (Displacement and Bump)")
+    if method != "BUMP":
+        bumped = sorted({n.type for n in graph.nodes if n.type in ("Bump", "NormalMap")})
+        if method == "BOTH":
+            bumped.insert(0, "Displacement and Bump")
+        if bumped:
+            graph.note(f"bump on a displaced surface ({', '.join(bumped)})", "displacement",
+                       "bumped at the displaced point and normal, not the undisplaced ones")
     link = graph.input(out, socket, Socket("Displacement", "vector", None), ())
     return link if isinstance(link, Link) else None
 

@@ -30,7 +30,12 @@ import numpy as np
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
-from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE, GEOMETRY_ATTRIBUTES
+from mcengine.shaders import (
+    DEFAULT_COLOR_ATTRIBUTE,
+    GEOMETRY_ATTRIBUTES,
+    SMOOTH_ATTRIBUTE,
+    VERTEX_NORMAL_ATTRIBUTE,
+)
 
 from .settings import hash_uint2
 
@@ -261,7 +266,7 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         uv_layer = _render_uv_layer(me)
         slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
-        attributes.update(_derived_attributes(me, vertices, triangles, wanted))
+        attributes.update(_derived_attributes(me, vertices, triangles, polygons, wanted))
         tangents_failed = _add_tangents(me, vertices, triangles, normals, tangents, uv_layer,
                                         attributes)
         texspace = _texspace(ob)
@@ -569,10 +574,17 @@ def _corner_attributes(me, corners, triangles, polygons, wanted) -> dict:
     return out
 
 
-def _derived_attributes(me, vertices, triangles, wanted) -> dict:
+def _derived_attributes(me, vertices, triangles, polygons, wanted) -> dict:
     """The attributes Cycles derives from the mesh for the Geometry node that some material
-    reads (``wanted``): Pointiness per vertex, Random Per Island per triangle."""
+    reads (``wanted``): Pointiness per vertex, Random Per Island per triangle; and for true
+    displacement (``mcengine.displacement``) the vertex normals and which faces are smooth."""
     out = {}
+    if VERTEX_NORMAL_ATTRIBUTE in wanted:
+        normals = _get(me.vertex_normals, "vector", np.float32, len(vertices) * 3).reshape(-1, 3)
+        out[VERTEX_NORMAL_ATTRIBUTE] = CornerTable(normals, triangles)
+        smooth = ~_polygon_values(me, "sharp_face", bool)[polygons]
+        out[SMOOTH_ATTRIBUTE] = CornerTable(smooth.astype(np.float32)[:, None],
+                                            _face_corners(np.arange(len(triangles))))
     names = GEOMETRY_ATTRIBUTES
     if names["Pointiness"] in wanted or names["Random Per Island"] in wanted:
         edges = _get(me.edges, "vertices", np.int32, len(me.edges) * 2).reshape(-1, 2)

@@ -38,6 +38,7 @@ _ATTRIBUTE = NODES["Attribute"].code
 _GEOMETRY = NODES["NewGeometry"].code
 _TC_USE_OBJECT = OFFSETS["TexCoord"]["prop:use_object"]
 _TC_INVERSE = OFFSETS["TexCoord"]["prop:object_inverse"]
+_TC_UNDISPLACED = OFFSETS["TexCoord"]["prop:undisplaced"]
 _UV_ATTRIBUTE = OFFSETS["UVMap"]["prop:attribute"]
 _ATTR_OFFSET = OFFSETS["Attribute"]["prop:attribute"]
 _ATTR_SIZE = OFFSETS["Attribute"]["prop:attribute_size"]
@@ -185,14 +186,21 @@ def tex_coord(regs, b, c, sd, tex):
     nx, ny, nz = sd.nx, sd.ny, sd.nz
     ob = sd.obj
     objects = tex.objects
-    # Generated: the object-space point in the object's texture space (world: the direction).
+    # Generated: the object-space point in the object's texture space (world: the direction);
+    # on a truly displaced mesh the point before displacement, as Cycles' generated attribute
+    # (the per-corner attribute at the offset in prop:undisplaced, ``mcengine.displacement``).
     gx, gy, gz = px, py, pz
     onx, ony, onz = nx, ny, nz
     ox, oy, oz = px, py, pz
     if ob >= 0 and sd.prim >= 0:
         row = objects[ob]
         ox, oy, oz = transform_point(row, OBJ_INVERSE, px, py, pz)
-        gx, gy, gz = texture_space(row, ox, oy, oz)
+        undisplaced = int(regs[b + _TC_UNDISPLACED])
+        if undisplaced >= 0:
+            ux, uy, uz, _uw = attribute(tex, sd, undisplaced, 3)
+            gx, gy, gz = texture_space(row, ux, uy, uz)
+        else:
+            gx, gy, gz = texture_space(row, ox, oy, oz)
         onx, ony, onz = normal_to_object(row, nx, ny, nz)
     if regs[b + _TC_USE_OBJECT] != 0.0:
         ox, oy, oz = transform_point(regs, b + _TC_INVERSE, px, py, pz)

@@ -344,7 +344,8 @@ VALUE_NODES = {
     # -- input family
     "Value": NodeSpec(101, (_f("prop:value", 0.0),), (_f("Value", 0.0),), True),
     "RGB": NodeSpec(102, (_c("prop:color", (0.5, 0.5, 0.5)),), (_c("Color", (0, 0, 0)),), True),
-    "TexCoord": NodeSpec(103, (_p("use_object", 0), Socket("prop:object_inverse", MATRIX, IDENTITY)),
+    "TexCoord": NodeSpec(103, (_p("use_object", 0), Socket("prop:object_inverse", MATRIX, IDENTITY),
+                               _p("undisplaced", -1)),
                          tuple(_v(name, UNLINKED) for name in TEX_COORD_OUTPUTS), False),
     "UVMap": NodeSpec(104, (_p("attribute", -1),), (_v("UV", UNLINKED),), False),
     "Attribute": NodeSpec(105, (_p("attribute", -1), _p("attribute_size", 0)),

@@ -55,6 +55,7 @@ SCENES = (
     "material_thin_film",
     "holdout_objects",
     "world_sky",
+    "material_displacement",
 )
 
 

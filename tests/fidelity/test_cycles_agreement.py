@@ -46,8 +46,8 @@ def test_scenes_exist():
             "world_hdri_interior",
             # the tangents of anisotropic closures; thin-film interference
             "material_anisotropic", "material_thin_film",
-            # holdout objects and collections
-            "holdout_objects"} <= names
+            # holdout objects and collections; true displacement
+            "holdout_objects", "material_displacement"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

@@ -122,6 +122,19 @@ def test_ignored_holdouts_are_caught(renders):
     assert differing and all(d["t"] > 0 for d in differing), differing
 
 
+def _displacement_as_bump(scene):
+    for name in ("Terrain", "Rock"):
+        bpy.data.materials[name].displacement_method = "BUMP"
+
+
+def test_displacement_rendered_as_bump_is_caught(renders):
+    """Meshes left where they are and only bumped (the 'Bump Only' method), where Cycles
+    moves them: the terrain's relief and the rock's silhouette change; blocks differ."""
+    result = renders.compare("material_displacement", "displacement as bump", _displacement_as_bump)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 def _unlinked(material, socket_owner, socket):
     def edit(scene):
         tree = bpy.data.materials[material].node_tree

@@ -1,5 +1,5 @@
 """True displacement: meshes moved by their material's Displacement before rendering
-(Material > Settings > Displacement 'Displacement Only' and 'Displacement and Bump').
+(Material > Settings > Displacement: 'Displacement Only' and 'Displacement and Bump').
 
 * ``Terrain``: a 3 m square (a quad at z = 0) with a Simple Subdivision Surface modifier of
   level 6 (64 x 64 quads), smooth; Principled BSDF, base (0.42, 0.5, 0.3), roughness 0.7;
@@ -7,8 +7,9 @@
   Noise texture's Fac on Generated coordinates (scale 2.5, detail 3).  Its normals are
   recomputed from the moved vertices, as Cycles does.
 * ``Rock``: a smooth 64x32 UV sphere r 0.4 at (0.55, -0.35, 0.75), Diffuse BSDF (0.6, 0.55,
-  0.5); 'Displacement Only' by a Displacement node (object space, midlevel 0, scale 0.12)
-  of a Voronoi texture's Distance (F1, scale 4) on Object coordinates.
+  0.5); 'Displacement and Bump' by a Displacement node (object space, midlevel 0, scale
+  0.12) of a Voronoi texture's Distance (F1, scale 4) on Object coordinates: moved, its
+  normals kept, and bumped by the same displacement evaluated at the undisplaced point.
 * ``Sun`` 3 W/m^2, angle 3 deg, from the left at 30 deg elevation; world (0.05, 0.06, 0.08).
 
 Run: .venv/bin/python blend_scenes/material_displacement.py
@@ -36,7 +37,7 @@ def _terrain_material():
 
 def _rock_material():
     material = c.node_material("Rock", "ShaderNodeBsdfDiffuse", color=(0.6, 0.55, 0.5))
-    material.displacement_method = "DISPLACEMENT"
+    material.displacement_method = "BOTH"
     tree = material.node_tree
     output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
     coords = c.shader_node(tree, "ShaderNodeTexCoord", location=(-900.0, -300.0))

@@ -10,14 +10,17 @@ Bump' moved as Cycles moves them before building the BVH (scene/mesh_displace.cp
   those at their corners and flat faces their new face normal; method 'BOTH' keeps the
   normals as they were (its bump perturbs them, starting from the undisplaced normal).
 * The Texture Coordinate's Generated output keeps reading the point before displacement
-  (Cycles' generated attribute), through the per-corner attribute ``UNDISPLACED_ATTRIBUTE``.
+  (Cycles' generated attribute), and Bump nodes (the bump of 'Displacement and Bump'
+  included) evaluate their heights at the undisplaced point, normal and ray differential, as
+  Cycles' bump evaluation does on such meshes: through the per-corner attributes
+  ``UNDISPLACED_ATTRIBUTE`` and ``UNDISPLACED_NORMAL_ATTRIBUTE`` (``kernels.svm.bump``).
 
 Differences from Cycles: this works on the scene's triangles in world space, per instance,
 where Cycles displaces a mesh once in object space (the same result unless the displacement
 reads world-space positions of an instanced mesh); faces with sharp edges or custom normals
-get recomputed vertex normals as smooth faces; Bump and Normal Map nodes of a displaced
-surface see the displaced point and normal, where Cycles shows them the undisplaced ones
-(warned at export).  The export supplies each corner's object-space vertex normal and
+get recomputed vertex normals as smooth faces; a tangent-space Normal Map on a displaced
+surface uses the displaced normal, where Cycles uses the undisplaced one (warned at
+export).  The export supplies each corner's object-space vertex normal and
 whether its face is smooth (``VERTEX_NORMAL_ATTRIBUTE``, ``SMOOTH_ATTRIBUTE``); without
 them, the corners' shading normals stand in for both.
 """
@@ -36,6 +39,7 @@ from .scene import Geometry, SceneDescription
 from .shaders import (
     SMOOTH_ATTRIBUTE,
     UNDISPLACED_ATTRIBUTE,
+    UNDISPLACED_NORMAL_ATTRIBUTE,
     VERTEX_NORMAL_ATTRIBUTE,
     compile_displacement,
     truly_displaced,
@@ -65,7 +69,11 @@ def displace(scene: SceneDescription) -> SceneDescription:
         local = (np.einsum("tij,tkj->tki", inverse[obj, :3, :3], corners) + inverse[obj, None, :3, 3])
     else:
         local = corners
-    attributes[UNDISPLACED_ATTRIBUTE] = local.astype(np.float32)
+    # The meshes Cycles gives undisplaced attributes: those with a displaced triangle.
+    displaced_mesh = np.isin(obj, obj[selected]).astype(np.float32)
+    attributes[UNDISPLACED_ATTRIBUTE] = np.concatenate(
+        [local, np.broadcast_to(displaced_mesh[:, None, None], (len(tris), 3, 1))], axis=2).astype(np.float32)
+    attributes[UNDISPLACED_NORMAL_ATTRIBUTE] = _object_normals(g, matrix, obj)
     before = dataclasses.replace(g, attributes=attributes)
 
     normals = _vertex_normals(g, matrix, obj, corner_tri, corner)
@@ -108,6 +116,18 @@ def _vertex_normals(g: Geometry, matrix, obj, corner_tri, corner) -> np.ndarray:
         n = np.einsum("vij,vj->vi", inverse_t[obj[corner_tri]], n)
     length = np.linalg.norm(n, axis=1, keepdims=True)
     return np.ascontiguousarray(n / np.where(length > 0.0, length, 1.0))
+
+
+def _object_normals(g: Geometry, matrix, obj) -> np.ndarray:
+    """(T, 3, 3) object-space vertex normals at the corners before displacement: the
+    exported ones, else the shading normals carried back by their object's matrix."""
+    exported = g.attributes.get(VERTEX_NORMAL_ATTRIBUTE)
+    if exported is not None:
+        return np.asarray(exported, np.float32)
+    n = np.asarray(g.normals, np.float64)
+    if len(matrix):
+        n = np.einsum("tji,tkj->tki", matrix[obj, :3, :3], n)       # M^T n
+    return _unit(n).astype(np.float32)
 
 
 def _evaluate(scene: SceneDescription, g: Geometry, corner_tri, corner, normals) -> np.ndarray:

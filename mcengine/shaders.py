@@ -56,10 +56,12 @@ from .kernels.state import (
     MF_TRANSPARENT,
 )
 from .kernels.svm import (
+    BUMP_CENTER,
     BUMP_DX,
     BUMP_DY,
     BUMP_LEAVE,
     BUMP_SET_NORMAL,
+    BUMP_UNDISPLACED,
     CONV_COLOR_TO_FLOAT,
     CONV_FLOAT_TO_VECTOR,
     CONV_VECTOR_TO_FLOAT,
@@ -79,6 +81,7 @@ from .kernels.svm import (
     eval_node,
     eval_shader,
 )
+from .kernels.svm.bump import BS_SIZE
 from .kernels.svm.nodes import (
     BUMP_HEIGHTS,
     CLOSURES,
@@ -114,11 +117,14 @@ GEOMETRY_ATTRIBUTES = {"Pointiness": ".pointiness", "Random Per Island": ".rando
 # mesh's vertices (true displacement, ``mcengine.displacement``): 'BOTH' does both.
 BUMP_METHODS = ("BUMP", "BOTH")
 TRUE_DISPLACEMENT_METHODS = ("DISPLACEMENT", "BOTH")
-# Per-corner attributes of truly displaced scenes: the object-space point before displacement
-# (what the Texture Coordinate's Generated output reads there, as Cycles' generated
-# attribute) and, from the export, each corner's object-space vertex normal and whether its
-# face is smooth (the direction of displacement and how normals are recomputed after it).
-UNDISPLACED_ATTRIBUTE = ".undisplaced"
+# Per-corner attributes of truly displaced scenes: the object-space point and vertex normal
+# before displacement (what the Texture Coordinate's Generated output reads there, as
+# Cycles' generated attribute, and where Bump nodes evaluate their heights, as Cycles'
+# undisplaced position and normal) and, from the export, each corner's object-space vertex
+# normal and whether its face is smooth (the direction of displacement and how normals are
+# recomputed after it).
+UNDISPLACED_ATTRIBUTE = ".undisplaced"           # x, y, z and 1 on displaced meshes (else 0)
+UNDISPLACED_NORMAL_ATTRIBUTE = ".undisplaced normal"   # object space: what bumps start from
 VERTEX_NORMAL_ATTRIBUTE = ".vertex normal"
 SMOOTH_ATTRIBUTE = ".smooth"
 NO_WEIGHT = -1      # weight register of a closure that reaches the output unmixed (weight 1)
@@ -224,6 +230,7 @@ class _Compiler:
         self.outputs: dict[int, dict] = {}       # value node -> its outputs (name -> Value)
         self.implicit: dict[str, Value] = {}     # texture coordinates inserted for unlinked inputs
         self.path: tuple = ()
+        self.undisplaced = False                 # compiling the bump of 'Displacement and Bump'
 
     def compile(self) -> Program:
         if self.surface is not None:
@@ -252,7 +259,11 @@ class _Compiler:
                        {"operation": "DOT_PRODUCT"}),
             ShaderNode("Bump", {"Height": Link(k + 1, "Value"), "Distance": 1.0, "Strength": 1.0},
                        {"use_object_space": float(self.material.displacement_method == "BOTH")})]
+        # On a truly displaced mesh Cycles evaluates this bump, and only this one, at the
+        # undisplaced point (svm_node_enter_bump_eval around it; user Bump nodes see P).
+        self.undisplaced = True
         normal = self.output(Link(k + 2, "Normal"))
+        self.undisplaced = False
         reg = normal.reg if not normal.constant else self.program.store(normal.const)
         self.program.ops[header] = [OP_BUMP, BUMP_SET_NORMAL, reg, len(self.program.ops) - header]
         # Nodes after this see the bumped normal: the surface compiles its own copies.
@@ -270,8 +281,19 @@ class _Compiler:
         if not isinstance(height, Link) or values[centre].constant:
             values[dx] = values[dy] = values[centre]
             return values
-        width_reg = self.program.store((width,))
-        for axis, i in ((BUMP_DX, dx), (BUMP_DY, dy)):
+        axes = ((BUMP_DX, dx), (BUMP_DY, dy))
+        point, _size = self.attributes.find(UNDISPLACED_ATTRIBUTE)
+        if point < 0 or not self.undisplaced:
+            width_reg = self.program.store((width,))
+        else:
+            # The bump of 'Displacement and Bump' in a scene with true displacement: every
+            # height at the undisplaced point (Cycles' svm_node_enter_bump_eval), the centre
+            # too; the node's state block.
+            normal, _size = self.attributes.find(UNDISPLACED_NORMAL_ATTRIBUTE)
+            width_reg = self.program.store((width, point, normal) + (0.0,) * (BS_SIZE - 3))
+            values[names.index("prop:state")] = Value(FLOAT, (float(width_reg),))
+            axes = tuple((BUMP_UNDISPLACED + axis, i) for axis, i in ((BUMP_CENTER, centre),) + axes)
+        for axis, i in axes:
             enter = len(self.program.ops)
             self.program.ops.append([OP_BUMP, axis, width_reg, 0])     # completed below
             saved = self.outputs, self.implicit

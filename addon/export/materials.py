@@ -115,20 +115,18 @@ def convert_material(ctx, material) -> Material:
 def _displacement(graph, material, out):
     """What the output's Displacement receives (a Link, else None): Cycles' bump from
     displacement (method 'BUMP'), true displacement of the mesh ('DISPLACEMENT',
-    ``mcengine.displacement``) or both ('BOTH').  On a displaced surface Cycles shows bumps
-    and normal maps the undisplaced point and normal, MC Engine the displaced ones: warned."""
+    ``mcengine.displacement``) or both ('BOTH').  A tangent-space Normal Map on a surface
+    whose normals displacement recomputed uses the new normal, where Cycles uses the
+    undisplaced one: warned."""
     socket = out.inputs["Displacement"]
     src = linked_node(socket)
     if src is None:
         return None
     method = str(getattr(material, "displacement_method", "BUMP"))
-    if method != "BUMP":
-        bumped = sorted({n.type for n in graph.nodes if n.type in ("Bump", "NormalMap")})
-        if method == "BOTH":
-            bumped.insert(0, "Displacement and Bump")
-        if bumped:
-            graph.note(f"bump on a displaced surface ({', '.join(bumped)})", "displacement",
-                       "bumped at the displaced point and normal, not the undisplaced ones")
+    if method == "DISPLACEMENT" and any(n.type == "NormalMap" and n.props.get("space", "TANGENT") == "TANGENT"
+                                        for n in graph.nodes):
+        graph.note("tangent-space Normal Map on a displaced surface", "displacement",
+                   "it perturbs the displaced normal, not the undisplaced one")
     link = graph.input(out, socket, Socket("Displacement", "vector", None), ())
     return link if isinstance(link, Link) else None
 

@@ -298,8 +298,7 @@ def test_material_settings_cycles_reads(scene, fake_session):
 @pytest.mark.parametrize("method", ["BUMP", "BOTH", "DISPLACEMENT"])
 def test_displacement_is_exported_with_its_method(scene, fake_session, method):
     """The output's Displacement is kept with the material's method: Cycles' automatic bump
-    ('Bump Only'), true displacement ('Displacement Only') or both; 'Displacement and Bump'
-    is warned (its bump sees the displaced point, where Cycles shows it the undisplaced one)."""
+    ('Bump Only'), true displacement ('Displacement Only') or both, without a warning."""
     mat = principled(f"Displaced {method}")
     mat.displacement_method = method
     tree = mat.node_tree
@@ -311,27 +310,28 @@ def test_displacement_is_exported_with_its_method(scene, fake_session, method):
     assert m.displacement_method == method
     assert m.nodes[m.displacement.node].type == "Displacement"
     assert m.nodes[m.nodes[m.displacement.node].inputs["Height"].node].type == "TexNoise"
-    if method == "BOTH":
-        assert len(warnings) == 1 and "bump on a displaced surface" in warnings[0], warnings
-    else:
-        assert warnings == []
+    assert warnings == []
 
 
-def test_a_bump_node_on_a_displaced_surface_is_warned(scene, fake_session):
-    """A Bump node in a truly displaced material is named in a warning; the same node under
-    'Bump Only' is not."""
-    for method, warned in (("DISPLACEMENT", True), ("BUMP", False)):
-        mat = principled(f"Bumped {method}")
+def test_a_tangent_normal_map_on_a_displaced_surface_is_warned(scene, fake_session):
+    """A tangent-space Normal Map in a 'Displacement Only' material (whose normals are
+    recomputed) is warned; under 'Displacement and Bump' (normals kept) it is not, nor a
+    Bump node."""
+    for method, warned in (("DISPLACEMENT", True), ("BOTH", False)):
+        mat = principled(f"Normal mapped {method}")
         mat.displacement_method = method
         tree = mat.node_tree
         noise = tree.nodes.new("ShaderNodeTexNoise")
         disp = tree.nodes.new("ShaderNodeDisplacement")
+        normal_map = tree.nodes.new("ShaderNodeNormalMap")
         bump = tree.nodes.new("ShaderNodeBump")
         tree.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+        tree.links.new(noise.outputs["Color"], normal_map.inputs["Color"])
         tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        tree.links.new(normal_map.outputs["Normal"], bump.inputs["Normal"])
         tree.links.new(bump.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
         tree.links.new(disp.outputs["Displacement"], tree.nodes["Material Output"].inputs["Displacement"])
         _m, warnings = exported(fake_session, mat)
         assert bool(warnings) == warned, warnings
         if warned:
-            assert "bump on a displaced surface (Bump)" in warnings[0]
+            assert "tangent-space Normal Map on a displaced surface" in warnings[0]

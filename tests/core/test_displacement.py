@@ -21,7 +21,12 @@ from mcengine.scene import (
     SceneDescription,
     ShaderNode,
 )
-from mcengine.shaders import SMOOTH_ATTRIBUTE, UNDISPLACED_ATTRIBUTE, VERTEX_NORMAL_ATTRIBUTE
+from mcengine.shaders import (
+    SMOOTH_ATTRIBUTE,
+    UNDISPLACED_ATTRIBUTE,
+    UNDISPLACED_NORMAL_ATTRIBUTE,
+    VERTEX_NORMAL_ATTRIBUTE,
+)
 
 SQUARE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float32)
 TRIS = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
@@ -77,8 +82,12 @@ def test_a_constant_height_lifts_every_vertex_along_its_normal():
     out = displace(_scene(_displaced_by(_constant(0.25)))).geometry
     np.testing.assert_allclose(out.vertices, SQUARE + [0.0, 0.0, 0.25], atol=1e-7)
     np.testing.assert_allclose(out.normals[..., 2], 1.0, atol=1e-7)
-    # What the Generated output reads there: the points before displacement.
-    np.testing.assert_allclose(out.attributes[UNDISPLACED_ATTRIBUTE], SQUARE[TRIS], atol=1e-7)
+    # What the Generated output and the bump of 'Displacement and Bump' read there: the
+    # points before displacement, flagged as on a displaced mesh, and the normals.
+    undisplaced = out.attributes[UNDISPLACED_ATTRIBUTE]
+    np.testing.assert_allclose(undisplaced[..., :3], SQUARE[TRIS], atol=1e-7)
+    assert np.all(undisplaced[..., 3] == 1.0)
+    np.testing.assert_allclose(out.attributes[UNDISPLACED_NORMAL_ATTRIBUTE][..., 2], 1.0, atol=1e-7)
     assert VERTEX_NORMAL_ATTRIBUTE not in out.attributes and SMOOTH_ATTRIBUTE not in out.attributes
 
 

@@ -21,6 +21,10 @@ and writes its closures at this point into the closure list ``cl`` (see
 ``OP_BUMP``        a = ``BUMP_DX`` or ``BUMP_DY``: the rows after it, up to its BUMP_LEAVE row c
                    rows further on, run at the point moved along dPdx or dPdy by the filter
                    width in register b (a Bump node's Height sub-graph, ``bump.bump_point``);
+                   plus ``BUMP_UNDISPLACED`` (with a = ``BUMP_CENTER`` too, the Height at the
+                   point itself): in a scene with true displacement, register b starts the
+                   Bump node's state block and the point is the undisplaced one
+                   (``bump.undisplaced_point``, Cycles' svm_node_enter_bump_eval);
                    a = ``BUMP_SET_NORMAL``, only as a program's first row: the rows after it,
                    up to c rows further on, run first (the output's Displacement), then the
                    shading normal is the vector in register b for the rest of the program
@@ -42,7 +46,7 @@ import numpy as np
 
 from ...jit import device, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
-from .bump import bump_point, with_normal
+from .bump import bump_point, undisplaced_point, with_normal
 from .closure_nodes import eval_closure_node
 from .color_nodes import eval_color_node
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
@@ -89,6 +93,8 @@ BUMP_LEAVE = 0                # OP_BUMP a
 BUMP_DX = 1
 BUMP_DY = 2
 BUMP_SET_NORMAL = 3
+BUMP_CENTER = 0               # with BUMP_UNDISPLACED: the Height at the (undisplaced) point
+BUMP_UNDISPLACED = 8          # added to BUMP_CENTER, BUMP_DX, BUMP_DY
 MAX_REGS = 1 << 22            # registers of all materials together (32 MiB per worker)
 
 # Implicit conversions of a link (OP_CONVERT c).
@@ -164,9 +170,18 @@ def eval_values(ops, start, end, regs, sd, tex, verts, tris):
             if ops[pc, 1] == BUMP_LEAVE:
                 point = sd
             else:
-                point = bump_point(sd, verts, tris, regs[ops[pc, 2]], ops[pc, 1])
+                point = region_point(ops, pc, regs, sd, tex, verts, tris)
         else:
             eval_row(ops, pc, regs, point, tex)
+
+
+@device
+def region_point(ops, pc, regs, sd, tex, verts, tris):
+    """The point the rows after ``OP_BUMP`` row pc run at (not ``BUMP_LEAVE``)."""
+    axis = ops[pc, 1]
+    if axis >= BUMP_UNDISPLACED:
+        return undisplaced_point(sd, verts, tris, regs, ops[pc, 2], axis - BUMP_UNDISPLACED, tex)
+    return bump_point(sd, verts, tris, regs[ops[pc, 2]], axis)
 
 
 @function
@@ -189,7 +204,7 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
             res = closure_row(ops, pc, regs, cl, sd, res)
         elif op == OP_BUMP:
             eval_values(ops, pc + 1, pc + ops[pc, 3], regs,
-                        bump_point(sd, verts, tris, regs[ops[pc, 2]], ops[pc, 1]), tex, verts, tris)
+                        region_point(ops, pc, regs, sd, tex, verts, tris), tex, verts, tris)
             skip = pc + ops[pc, 3] + 1
         else:
             eval_row(ops, pc, regs, sd, tex)

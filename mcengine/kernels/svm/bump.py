@@ -26,7 +26,7 @@ import math
 
 from ...jit import device, function
 from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
-from .input_nodes import normal_to_object, normal_to_world, transform_direction
+from .input_nodes import normal_to_object, normal_to_world, transform_direction, transform_point
 from .math_nodes import safe_normalize
 from .nodes import OFFSETS, SPACE_OBJECT
 
@@ -39,6 +39,7 @@ _BUMP_HEIGHT_DY = OFFSETS["Bump"]["Height_dy"]
 _BUMP_NORMAL = OFFSETS["Bump"]["Normal"]
 _BUMP_INVERT = OFFSETS["Bump"]["prop:invert"]
 _BUMP_OBJECT = OFFSETS["Bump"]["prop:use_object_space"]
+_BUMP_STATE = OFFSETS["Bump"]["prop:state"]
 _DISP_HEIGHT = OFFSETS["Displacement"]["Height"]
 _DISP_MIDLEVEL = OFFSETS["Displacement"]["Midlevel"]
 _DISP_SCALE = OFFSETS["Displacement"]["Scale"]
@@ -66,6 +67,29 @@ def differentials(sd):
     return d * ax, d * ay, d * az, d * bx, d * by, d * bz
 
 
+@device
+def barycentric_step(sd, verts, tris, ex, ey, ez):
+    """(du, dv) with e = du e1 + dv e2 in the plane of the point's triangle (Cramer's rule
+    about its normal); (0, 0) off a triangle."""
+    p = sd.prim
+    if p < 0:
+        return 0.0, 0.0
+    t = tris[p]
+    v0, v1, v2 = verts[t[0]], verts[t[1]], verts[t[2]]
+    e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
+    e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+    nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+    den = nx * nx + ny * ny + nz * nz
+    if den <= 0.0:
+        return 0.0, 0.0
+    # On a back face Cycles has negated dPdu and dPdv before solving for du, dv, so
+    # its attributes (UV maps, colours, the Texture Coordinate's Normal) move the
+    # other way than P: kept, to agree with it.
+    sign = -1.0 if sd.backfacing else 1.0
+    return (sign * ((ey * e2z - ez * e2y) * nx + (ez * e2x - ex * e2z) * ny + (ex * e2y - ey * e2x) * nz) / den,
+            sign * ((e1y * ez - e1z * ey) * nx + (e1z * ex - e1x * ez) * ny + (e1x * ey - e1y * ex) * nz) / den)
+
+
 @function
 def bump_point(sd, verts, tris, width, axis):
     """The shading point moved by ``width`` times dPdx (axis 1) or dPdy (axis 2), with its
@@ -75,28 +99,85 @@ def bump_point(sd, verts, tris, width, axis):
         ex, ey, ez = width * xx, width * xy, width * xz
     else:
         ex, ey, ez = width * yx, width * yy, width * yz
-    u, v = sd.u, sd.v
-    p = sd.prim
-    if p >= 0:
-        # Solve e = du e1 + dv e2 in the triangle's plane (Cramer's rule about its normal).
-        t = tris[p]
-        v0, v1, v2 = verts[t[0]], verts[t[1]], verts[t[2]]
-        e1x, e1y, e1z = v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]
-        e2x, e2y, e2z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
-        nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
-        den = nx * nx + ny * ny + nz * nz
-        if den > 0.0:
-            # On a back face Cycles has negated dPdu and dPdv before solving for du, dv, so
-            # its attributes (UV maps, colours, the Texture Coordinate's Normal) move the
-            # other way than P: kept, to agree with it.
-            sign = -1.0 if sd.backfacing else 1.0
-            u += sign * ((ey * e2z - ez * e2y) * nx + (ez * e2x - ex * e2z) * ny + (ex * e2y - ey * e2x) * nz) / den
-            v += sign * ((e1y * ez - e1z * ey) * nx + (e1z * ex - e1x * ez) * ny + (e1x * ey - e1y * ex) * nz) / den
+    du, dv = barycentric_step(sd, verts, tris, ex, ey, ez)
     return ShadingData(sd.px + ex, sd.py + ey, sd.pz + ez, sd.nx, sd.ny, sd.nz, sd.ngx, sd.ngy, sd.ngz,
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
-                       sd.refractive_caustics, sd.bump_correction, sd.prim, u, v, sd.obj,
+                       sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u + du, sd.v + dv, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
                        sd.transmission_depth, sd.transparent_depth, sd.dp)
+
+
+# A Bump node's state block on truly displaced meshes (register b of its ``OP_BUMP`` rows
+# with ``BUMP_UNDISPLACED`` set, and its prop:state): the filter width, the offsets of the
+# undisplaced point and normal attributes (``mcengine.displacement``), then what its Height's
+# evaluations found there for ``bump_normal``: the undisplaced dPdx, dPdy and normal (a zero
+# normal: the point is not on a displaced mesh).
+BS_WIDTH = 0
+BS_POINT = 1
+BS_NORMAL = 2
+BS_DPDX = 3
+BS_DPDY = 6
+BS_N = 9
+BS_SIZE = 12
+
+
+@function
+def undisplaced_point(sd, verts, tris, regs, s, axis, tex):
+    """What a Bump node's Height sees on a truly displaced mesh, as Cycles'
+    svm_node_enter_bump_eval sets it up: the point and normal before displacement (the
+    attributes named in state block ``s``), the compact ray differential of the undisplaced
+    triangle, moved along dPdx (axis 1) or dPdy (axis 2) by the filter width as
+    ``bump_point`` moves the displaced point (Cycles' svm_node_bump_P_dx keeps the hit
+    triangle's dPdu and du).  Records the undisplaced dPdx, dPdy and normal in the block.  On a
+    mesh without true displacement (the attribute's flag 0) the point is ``bump_point``'s
+    (axis 0: ``sd`` itself) and the recorded normal zero."""
+    p = sd.prim
+    off_p = int(regs[s + BS_POINT])
+    off_n = int(regs[s + BS_NORMAL])
+    width = regs[s + BS_WIDTH]
+    if p < 0 or sd.obj < 0 or off_p < 0 or tex.attr[p, 0, off_p + 3] <= 0.0:
+        regs[s + BS_N] = regs[s + BS_N + 1] = regs[s + BS_N + 2] = 0.0
+        if axis == 0:
+            return sd
+        return bump_point(sd, verts, tris, width, axis)
+    row = tex.objects[sd.obj]
+    xx, xy, xz, yx, yy, yz = differentials(sd)
+    dua, dva = barycentric_step(sd, verts, tris, xx, xy, xz)
+    dub, dvb = barycentric_step(sd, verts, tris, yx, yy, yz)
+    a = tex.attr
+    c0x, c0y, c0z = float(a[p, 0, off_p]), float(a[p, 0, off_p + 1]), float(a[p, 0, off_p + 2])
+    e1x, e1y, e1z = float(a[p, 1, off_p]) - c0x, float(a[p, 1, off_p + 1]) - c0y, float(a[p, 1, off_p + 2]) - c0z
+    e2x, e2y, e2z = float(a[p, 2, off_p]) - c0x, float(a[p, 2, off_p + 1]) - c0y, float(a[p, 2, off_p + 2]) - c0z
+    u, v = sd.u, sd.v
+    px, py, pz = transform_point(row, OBJ_MATRIX, c0x + u * e1x + v * e2x, c0y + u * e1y + v * e2y,
+                                 c0z + u * e1z + v * e2z)
+    dxx, dxy, dxz = transform_direction(row, OBJ_MATRIX, dua * e1x + dva * e2x, dua * e1y + dva * e2y,
+                                        dua * e1z + dva * e2z)
+    dyx, dyy, dyz = transform_direction(row, OBJ_MATRIX, dub * e1x + dvb * e2x, dub * e1y + dvb * e2y,
+                                        dub * e1z + dvb * e2z)
+    b0 = 1.0 - u - v
+    nx = b0 * float(a[p, 0, off_n]) + u * float(a[p, 1, off_n]) + v * float(a[p, 2, off_n])
+    ny = b0 * float(a[p, 0, off_n + 1]) + u * float(a[p, 1, off_n + 1]) + v * float(a[p, 2, off_n + 1])
+    nz = b0 * float(a[p, 0, off_n + 2]) + u * float(a[p, 1, off_n + 2]) + v * float(a[p, 2, off_n + 2])
+    nx, ny, nz = normal_to_world(row, nx, ny, nz)
+    if sd.backfacing:
+        nx, ny, nz = -nx, -ny, -nz
+    regs[s + BS_DPDX], regs[s + BS_DPDX + 1], regs[s + BS_DPDX + 2] = dxx, dxy, dxz
+    regs[s + BS_DPDY], regs[s + BS_DPDY + 1], regs[s + BS_DPDY + 2] = dyx, dyy, dyz
+    regs[s + BS_N], regs[s + BS_N + 1], regs[s + BS_N + 2] = nx, ny, nz
+    dp = 0.5 * (math.sqrt(dxx * dxx + dxy * dxy + dxz * dxz) + math.sqrt(dyx * dyx + dyy * dyy + dyz * dyz))
+    # The heights' offsets are the displaced triangle's (Cycles' dPdu du.dx + dPdv dv.dx, its
+    # barycentric steps unchanged by the bump evaluation): the same as bump_point's.
+    ex = ey = ez = du = dv = 0.0
+    if axis == 1:
+        ex, ey, ez, du, dv = width * xx, width * xy, width * xz, width * dua, width * dva
+    elif axis == 2:
+        ex, ey, ez, du, dv = width * yx, width * yy, width * yz, width * dub, width * dvb
+    return ShadingData(px + ex, py + ey, pz + ez, nx, ny, nz, sd.ngx, sd.ngy, sd.ngz,
+                       sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
+                       sd.refractive_caustics, sd.bump_correction, sd.prim, u + du, v + dv, sd.obj,
+                       sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
+                       sd.transmission_depth, sd.transparent_depth, dp)
 
 
 @device
@@ -113,9 +194,20 @@ def with_normal(sd, nx, ny, nz):
 def bump_normal(regs, b, sd, tex):
     """Cycles' svm_node_set_bump: the bumped normal from the three heights."""
     nx, ny, nz = regs[b + _BUMP_NORMAL], regs[b + _BUMP_NORMAL + 1], regs[b + _BUMP_NORMAL + 2]
+    state = int(regs[b + _BUMP_STATE])
+    undisplaced = state >= 0 and (regs[state + BS_N] != 0.0 or regs[state + BS_N + 1] != 0.0
+                                  or regs[state + BS_N + 2] != 0.0)
     if nx == 0.0 and ny == 0.0 and nz == 0.0:
-        nx, ny, nz = sd.nx, sd.ny, sd.nz
-    xx, xy, xz, yx, yy, yz = differentials(sd)
+        if undisplaced:
+            # Cycles' bump evaluation left the undisplaced normal in sd->N.
+            nx, ny, nz = regs[state + BS_N], regs[state + BS_N + 1], regs[state + BS_N + 2]
+        else:
+            nx, ny, nz = sd.nx, sd.ny, sd.nz
+    if undisplaced:
+        xx, xy, xz = regs[state + BS_DPDX], regs[state + BS_DPDX + 1], regs[state + BS_DPDX + 2]
+        yx, yy, yz = regs[state + BS_DPDY], regs[state + BS_DPDY + 1], regs[state + BS_DPDY + 2]
+    else:
+        xx, xy, xz, yx, yy, yz = differentials(sd)
     object_space = regs[b + _BUMP_OBJECT] != 0.0 and sd.obj >= 0
     if object_space:
         row = tex.objects[sd.obj]

@@ -188,7 +188,8 @@ def tex_coord(regs, b, c, sd, tex):
     objects = tex.objects
     # Generated: the object-space point in the object's texture space (world: the direction);
     # on a truly displaced mesh the point before displacement, as Cycles' generated attribute
-    # (the per-corner attribute at the offset in prop:undisplaced, ``mcengine.displacement``).
+    # (the per-corner attribute at the offset in prop:undisplaced, whose fourth component
+    # says whether the triangle's mesh is displaced: ``mcengine.displacement``).
     gx, gy, gz = px, py, pz
     onx, ony, onz = nx, ny, nz
     ox, oy, oz = px, py, pz
@@ -196,7 +197,7 @@ def tex_coord(regs, b, c, sd, tex):
         row = objects[ob]
         ox, oy, oz = transform_point(row, OBJ_INVERSE, px, py, pz)
         undisplaced = int(regs[b + _TC_UNDISPLACED])
-        if undisplaced >= 0:
+        if undisplaced >= 0 and tex.attr[sd.prim, 0, undisplaced + 3] > 0.0:
             ux, uy, uz, _uw = attribute(tex, sd, undisplaced, 3)
             gx, gy, gz = texture_space(row, ux, uy, uz)
         else:

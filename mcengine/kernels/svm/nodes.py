@@ -494,7 +494,8 @@ VALUE_NODES = {
     # copies of its sub-graph at the offset points (BUMP_HEIGHTS; svm/bump.py)
     "Bump": NodeSpec(602, (_f("Strength", 1.0), _f("Distance", 0.001), _f("Filter Width", 0.1),
                            _f("Height", 1.0), _f("Height_dx", 1.0), _f("Height_dy", 1.0), _v("Normal"),
-                           _p("invert", 0), _p("use_object_space", 0)), (_v("Normal", UNLINKED),), False),
+                           _p("invert", 0), _p("use_object_space", 0), _p("state", -1)),
+                     (_v("Normal", UNLINKED),), False),
     "Displacement": NodeSpec(603, (_f("Height", 0.0), _f("Midlevel", 0.5), _f("Scale", 0.01), _v("Normal"),
                                    _p("space", SPACE_OBJECT)), (_v("Displacement", UNLINKED),), False),
 }

@@ -19,35 +19,33 @@ import math
 import _common as c
 
 
+def _displaced(material, method, texture, coordinate, output, texture_values, midlevel, scale):
+    """Displace ``material`` (method 'DISPLACEMENT' or 'BOTH') by a Displacement node (object
+    space) of ``texture``'s ``output`` on Texture Coordinate ``coordinate``."""
+    material.displacement_method = method
+    tree = material.node_tree
+    out = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    coords = c.shader_node(tree, "ShaderNodeTexCoord", location=(-900.0, -300.0))
+    tex = c.shader_node(tree, texture, location=(-600.0, -300.0), **texture_values)
+    disp = c.shader_node(tree, "ShaderNodeDisplacement", location=(-300.0, -300.0), midlevel=midlevel,
+                         scale=scale, space="OBJECT")
+    tree.links.new(coords.outputs[coordinate], tex.inputs["Vector"])
+    tree.links.new(tex.outputs[output], disp.inputs["Height"])
+    tree.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+    return material
+
+
 def _terrain_material():
     material = c.node_material("Terrain", "ShaderNodeBsdfPrincipled", base_color=(0.42, 0.5, 0.3),
                                roughness=0.7)
-    material.displacement_method = "DISPLACEMENT"
-    tree = material.node_tree
-    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
-    coords = c.shader_node(tree, "ShaderNodeTexCoord", location=(-900.0, -300.0))
-    noise = c.shader_node(tree, "ShaderNodeTexNoise", location=(-600.0, -300.0), scale=2.5, detail=3.0)
-    disp = c.shader_node(tree, "ShaderNodeDisplacement", location=(-300.0, -300.0), midlevel=0.5,
-                         scale=0.6, space="OBJECT")
-    tree.links.new(coords.outputs["Generated"], noise.inputs["Vector"])
-    tree.links.new(noise.outputs["Fac"], disp.inputs["Height"])
-    tree.links.new(disp.outputs["Displacement"], output.inputs["Displacement"])
-    return material
+    return _displaced(material, "DISPLACEMENT", "ShaderNodeTexNoise", "Generated", "Fac",
+                      {"scale": 2.5, "detail": 3.0}, midlevel=0.5, scale=0.6)
 
 
 def _rock_material():
     material = c.node_material("Rock", "ShaderNodeBsdfDiffuse", color=(0.6, 0.55, 0.5))
-    material.displacement_method = "BOTH"
-    tree = material.node_tree
-    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
-    coords = c.shader_node(tree, "ShaderNodeTexCoord", location=(-900.0, -300.0))
-    voronoi = c.shader_node(tree, "ShaderNodeTexVoronoi", location=(-600.0, -300.0), scale=4.0)
-    disp = c.shader_node(tree, "ShaderNodeDisplacement", location=(-300.0, -300.0), midlevel=0.0,
-                         scale=0.12, space="OBJECT")
-    tree.links.new(coords.outputs["Object"], voronoi.inputs["Vector"])
-    tree.links.new(voronoi.outputs["Distance"], disp.inputs["Height"])
-    tree.links.new(disp.outputs["Displacement"], output.inputs["Displacement"])
-    return material
+    return _displaced(material, "BOTH", "ShaderNodeTexVoronoi", "Object", "Distance", {"scale": 4.0},
+                      midlevel=0.0, scale=0.12)
 
 
 def build(scene):

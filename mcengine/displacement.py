@@ -58,7 +58,7 @@ def displace(scene: SceneDescription) -> SceneDescription:
     corner_tri = selected[first // 3]
     corner = first % 3
 
-    matrix, _texspace, _info = g.object_arrays()
+    matrix, texspace, _info = g.object_arrays()
     inverse = np.linalg.inv(matrix)
     obj = np.clip(np.asarray(g.object_index, np.int64), 0, max(len(matrix) - 1, 0))
     world = np.asarray(g.vertices, np.float64)
@@ -74,7 +74,8 @@ def displace(scene: SceneDescription) -> SceneDescription:
     attributes[UNDISPLACED_ATTRIBUTE] = np.concatenate(
         [local, np.broadcast_to(displaced_mesh[:, None, None], (len(tris), 3, 1))], axis=2).astype(np.float32)
     attributes[UNDISPLACED_NORMAL_ATTRIBUTE] = _object_normals(g, matrix, obj)
-    before = dataclasses.replace(g, attributes=attributes)
+    # The texture space stays the undisplaced mesh's (an automatic one is not recomputed).
+    before = dataclasses.replace(g, attributes=attributes, object_texspace=texspace)
 
     normals = _vertex_normals(g, matrix, obj, corner_tri, corner)
     offsets = _evaluate(scene, before, corner_tri, corner, normals)

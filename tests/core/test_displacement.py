@@ -89,6 +89,8 @@ def test_a_constant_height_lifts_every_vertex_along_its_normal():
     assert np.all(undisplaced[..., 3] == 1.0)
     np.testing.assert_allclose(out.attributes[UNDISPLACED_NORMAL_ATTRIBUTE][..., 2], 1.0, atol=1e-7)
     assert VERTEX_NORMAL_ATTRIBUTE not in out.attributes and SMOOTH_ATTRIBUTE not in out.attributes
+    # The automatic texture space is the undisplaced square's (centred at z = 0).
+    np.testing.assert_allclose(out.object_texspace[0, 0], [0.5, 0.5, 0.0], atol=1e-7)
 
 
 def test_a_shared_vertex_takes_the_first_triangles_value():

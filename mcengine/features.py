@@ -56,6 +56,7 @@ from .kernels.state import (
 )
 from .kernels.svm import OP_NODE
 from .scene import Link
+from .shaders import UNDISPLACED_ATTRIBUTE
 
 # Effect name -> (label for people, cfg flag that switches it in the kernels).
 EFFECTS = {
@@ -78,6 +79,7 @@ class EffectsPlan:
     world_shader: bool = False     # the world varies (its shader runs for escaped rays)
     world_sampled: bool = False    # the world is a light for next-event estimation (its map)
     camera: tuple = ()             # "depth of field", "motion blur (...)": what the camera sees
+    displaced: int = 0             # meshes moved by true displacement (``displacement``)
     # The effects (see the module docstring); each is a kernel flag.
     nee: bool = False
     lamps_hit: bool = False
@@ -119,6 +121,8 @@ class EffectsPlan:
                     if self.textures else "no textures")
         if self.images:
             textures += f", {self.images} image{'s' if self.images > 1 else ''}"
+        if self.displaced:
+            textures += f"; {self.displaced} displaced mesh{'es' if self.displaced > 1 else ''}"
         camera = f"; {', '.join(self.camera)}" if self.camera else ""
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
                 f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures}{camera} | "
@@ -182,6 +186,7 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         lobes=tuple(k for k in LOBE_ORDER if k in kinds),
         textures=textures,
         camera=camera_effects(scene),
+        displaced=displaced_meshes(scene.geometry),
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
@@ -194,6 +199,16 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         mis=nee and (lamps_hit or emissive_triangles > 0 or world_sampled),
         caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
     )
+
+
+def displaced_meshes(geometry) -> int:
+    """How many objects true displacement moved (their triangles carry the undisplaced points,
+    flagged)."""
+    undisplaced = geometry.attributes.get(UNDISPLACED_ATTRIBUTE)
+    if undisplaced is None:
+        return 0
+    flagged = np.asarray(undisplaced)[:, 0, 3] > 0.0
+    return len(np.unique(np.asarray(geometry.object_index)[flagged]))
 
 
 def camera_effects(scene) -> tuple:

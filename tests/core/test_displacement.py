@@ -148,3 +148,16 @@ def test_a_scaled_object_moves_in_its_own_space():
     g = dataclasses.replace(g, object_matrix=matrix[None])
     out = displace(_scene(_displaced_by(_constant(0.25)), g)).geometry
     np.testing.assert_allclose(out.vertices[:, 2], 0.75, atol=1e-6)
+
+
+def test_the_effects_plan_names_the_displaced_meshes():
+    """The plan's line (panel, command line, reports) says how many meshes moved; a scene
+    displaced only as bump moves none and says nothing."""
+    from mcengine.features import detect
+    from mcengine.packing import pack_scene
+
+    moved = pack_scene(displace(_scene(_displaced_by(_constant(0.25))))).plan
+    assert moved.displaced == 1 and "1 displaced mesh" in moved.summary()
+    bumped = _scene(_displaced_by(_constant(0.25), "BUMP"))
+    plan = detect(displace(bumped), 0, [], np.zeros(1, np.int32))
+    assert plan.displaced == 0 and "displaced" not in plan.summary()

@@ -138,23 +138,39 @@ def shift_cos_in(cos_in, frequency):
     return max(math.cos(math.acos(cos_in) * frequency), 0.0) / cos_in
 
 
+@device
+def diffuse_closure_eval(cl, k, t, wix, wiy, wiz):
+    """``closure_eval`` of a Lambert or translucent closure k (type t): they read only the
+    light's cosine to the normal, so no frame is built; inlined where closure lists are
+    summed (``_eval_sum``), which saves the call for the commonest closure."""
+    shadowing = bump_shadowing(cl, k, True, True, wix, wiy, wiz)
+    if shadowing == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    liz = cl[k, CL_N] * wix + cl[k, CL_N + 1] * wiy + cl[k, CL_N + 2] * wiz
+    if t == CT_DIFFUSE:
+        r, g, b, pdf = lambert_eval(cl, k, 0.0, 0.0, 0.0, 0.0, 0.0, liz)
+    else:
+        r, g, b, pdf = translucent_eval(cl, k, 0.0, 0.0, 0.0, 0.0, 0.0, liz)
+    if cl[k, CL_TERMINATOR] > 1.0:
+        shadowing *= shift_cos_in(liz, cl[k, CL_TERMINATOR])
+    return r * shadowing, g * shadowing, b * shadowing, pdf
+
+
 @function
 def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
     """(r, g, b, pdf) of closure k for world directions, without its weight (times the bump
     shadowing term; a direction it rejects has pdf 0)."""
     t = cl[k, CL_TYPE]
+    if t == CT_DIFFUSE or t == CT_TRANSLUCENT:
+        return diffuse_closure_eval(cl, k, t, wix, wiy, wiz)
     shadowing = bump_shadowing(cl, k, is_diffuse(t), True, wix, wiy, wiz)
     if shadowing == 0.0:
         return 0.0, 0.0, 0.0, 0.0
     tx, ty, tz, bx, by, bz, nx, ny, nz = frame(cl, k)
     lox, loy, loz = wox * tx + woy * ty + woz * tz, wox * bx + woy * by + woz * bz, wox * nx + woy * ny + woz * nz
     lix, liy, liz = wix * tx + wiy * ty + wiz * tz, wix * bx + wiy * by + wiz * bz, wix * nx + wiy * ny + wiz * nz
-    if t == CT_DIFFUSE:
-        r, g, b, pdf = lambert_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    elif t == CT_OREN_NAYAR:
+    if t == CT_OREN_NAYAR:
         r, g, b, pdf = oren_nayar_eval(cl, k, lox, loy, loz, lix, liy, liz)
-    elif t == CT_TRANSLUCENT:
-        r, g, b, pdf = translucent_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_SHEEN:
         r, g, b, pdf = sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
@@ -226,7 +242,10 @@ def _eval_sum(cl, n, skip, wox, woy, woz, wix, wiy, wiz, exclude, fr, fg, fb, su
         sum_sw += sw
         if t == CT_TRANSPARENT:
             continue
-        r, g, b, pdf = closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz)
+        if t == CT_DIFFUSE or t == CT_TRANSLUCENT:
+            r, g, b, pdf = diffuse_closure_eval(cl, k, t, wix, wiy, wiz)
+        else:
+            r, g, b, pdf = closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz)
         if pdf != 0.0:
             if not excluded(t, exclude):
                 fr += cl[k, CL_W] * r

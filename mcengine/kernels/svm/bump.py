@@ -16,6 +16,11 @@ with N the Normal input (unlinked: the shading normal), d the Distance (negated 
 Invert), w the filter width and s = max(Strength, 0); in object space (displacement
 as bump with method 'BOTH') N and the differentials are taken to object space first.
 
+On a truly displaced mesh ('Displacement and Bump') the bump the compiler makes of the
+material's Displacement evaluates its heights where Cycles' svm_node_enter_bump_eval puts
+them: at the point and normal before displacement, with the undisplaced triangle's
+differentials (``undisplaced_point``); Bump nodes of the surface keep the displaced point.
+
 The Displacement node (``svm_node_displacement``) gives N (h - midlevel) scale, in object
 space N taken there and the vector brought back as a direction; the material output's
 Displacement becomes a bump through the compiler (``shaders``: displacement as bump).

@@ -245,11 +245,6 @@ def ensure_valid_reflection(sd, nx, ny, nz):
 # The microfacet set-ups read several tables; they are called, not inlined, so that each
 # is compiled once rather than into every closure node (see jit.function).
 @function
-def microfacet_setup(cl, k):
-    mf.microfacet_setup(cl, k)
-
-
-@function
 def microfacet_setup_fresnel_constant(cl, k, cos_no, cr, cg, cb):
     mf.microfacet_setup_fresnel_constant(cl, k, cos_no, cr, cg, cb)
 
@@ -285,7 +280,7 @@ def microfacet(cl, k, ctype, distribution, ax, ay, eta, nx, ny, nz, tx, ty, tz, 
     cl[k, CL_ETA] = eta
     cl[k, CL_FRESNEL] = FR_NONE
     set_frame(cl, k, nx, ny, nz, tx, ty, tz)
-    microfacet_setup(cl, k)
+    mf.microfacet_setup(cl, k)
     return sd.wox * nx + sd.woy * ny + sd.woz * nz
 
 

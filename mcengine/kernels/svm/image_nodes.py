@@ -77,7 +77,6 @@ _TS_INTENSITY = _TS["prop:sun_intensity"]
 _TS_HORIZON = _TS["prop:sky_horizon"]
 _TS_BOTTOM = _TS["prop:sky_bottom_x"]     # x, y, z follow
 _TS_TOP = _TS["prop:sky_top_x"]
-_XYZ_TO_RGB = XYZ_TO_RGB
 
 # Texture coordinates beyond this many texels are read at 0 (their integer index would
 # overflow; Cycles' own result there is undefined).
@@ -410,7 +409,7 @@ def sky_texture_node(regs, b, c, tex):
     sx_, sy_, sz_, _ = image_texture(tex, int(regs[b + _TS_IMAGE]), u, vv, INTERP_LINEAR,
                                      EXT_EXTEND, False)
     cx, cy, cz = cx + sx_, cy + sy_, cz + sz_
-    m = _XYZ_TO_RGB
+    m = XYZ_TO_RGB
     regs[c] = max(m[0, 0] * cx + m[0, 1] * cy + m[0, 2] * cz, 0.0)
     regs[c + 1] = max(m[1, 0] * cx + m[1, 1] * cy + m[1, 2] * cz, 0.0)
     regs[c + 2] = max(m[2, 0] * cx + m[2, 1] * cy + m[2, 2] * cz, 0.0)

@@ -276,6 +276,32 @@ def test_albedo_estimate():
     assert est == pytest.approx(mean[0] / mf.microfacet_albedo_tables(refl, 0, mu)[0], rel=0.05)
 
 
+@needs_tables
+@pytest.mark.parametrize("f0, rtint, mu", [
+    ((0.04, 0.04, 0.04), (1.0, 1.0, 1.0), 0.5),    # the Principled's specular layer: the table
+    ((0.0, 0.3, 0.1), (1.0, 0.0, 1.0), 0.3),       # one channel without F0, one without tint
+    ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), 0.5),       # F0 = 0: the smooth reflection is s > 0
+    ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0), 1.0),       # ... and exactly 0 at normal incidence
+    ((0.04, 0.04, 0.04), (0.0, 0.0, 0.0), 0.5),    # no tint: no reflection
+])
+@pytest.mark.parametrize("ctype, transmission", [(CT_MICROFACET, True), (CT_MICROFACET_GLASS, False)])
+def test_albedo_estimate_of_a_reflection_without_its_smooth_fresnel(f0, rtint, mu, ctype, transmission):
+    """``microfacet_albedo`` skips the smooth Fresnel where it would discard it (FR_SCHLICK,
+    exponent < 0, reflection only); the result is still Cycles': nothing where the smooth
+    reflection is zero in every channel, else the table's mix(F0, F90, s) x tint."""
+    from mcengine.kernels.closures.fresnel import F0_from_ior, fresnel_dielectric
+    from mcengine.kernels.closures.tables import GGX_GEN_SCHLICK_IOR_S, lookup_3d
+    eta = 1.5
+    cl = microfacet_row(ctype=ctype, alpha=0.25, eta=eta, fresnel=FR_SCHLICK, f0=f0, exponent=-eta,
+                        rtint=rtint, ttint=(0.0, 0.0, 0.0) if ctype == CT_MICROFACET else (1.0, 1.0, 1.0))
+    f0_eta = F0_from_ior(eta)
+    s_smooth = min(max((fresnel_dielectric(mu, eta)[0] - f0_eta) / (1.0 - f0_eta), 0.0), 1.0)
+    smooth = [(f + (1.0 - f) * s_smooth) * t for f, t in zip(f0, rtint)]
+    s = lookup_3d(GGX_GEN_SCHLICK_IOR_S, 0.5, mu, math.sqrt(0.5 / 2.5))
+    expected = [0.0] * 3 if not any(smooth) else [(f + (1.0 - f) * s) * t for f, t in zip(f0, rtint)]
+    assert mf.microfacet_albedo(cl, 0, mu, True, transmission) == pytest.approx(expected, rel=1e-12, abs=0)
+
+
 # -- Cycles' measured values -----------------------------------------------------------------------
 # cycles-closures.md section 10: a 1000 W point light at 2 m, orthographic camera on the normal.
 @pytest.mark.parametrize("row, light, cycles", [

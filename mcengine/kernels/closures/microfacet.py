@@ -105,8 +105,9 @@ from .thin_film import (
 # ``function`` (called, not inlined): the Beckmann sampler (and its erfinv) costs about 0.5 us,
 # so a call costs nothing measurable.  The setup helpers (albedo estimate, energy
 # compensation: table lookups) are inlined into the Fresnel set-ups, which the closure nodes
-# call (``svm.closure_nodes``): four calls fewer per microfacet closure, measured 7 % more
-# paths per second on the default Principled BSDF, for 8 % more compile time.
+# call (``svm.closure_nodes``): four calls fewer per microfacet closure, about 7 % more paths
+# per second on the default Principled BSDF (benchmarks/bench_cornell.py), for 5-10 % more
+# compile time.
 
 _INV_PI = 1.0 / math.pi
 _SQRT_PI = math.sqrt(math.pi)
@@ -742,14 +743,22 @@ def microfacet_preserve_energy(cl, k, cos_no, fss_r, fss_g, fss_b):
     cl[k, CL_ENERGY] = energy
     if fss_r == 1.0 and fss_g == 1.0 and fss_b == 1.0:
         return
-    total = 0.0
-    for c in range(3):
-        fss = fss_r if c == 0 else (fss_g if c == 1 else fss_b)
-        fms = fss * e_avg / (1.0 - fss * (1.0 - e_avg))
-        dark = (1.0 + fms * missing) / energy
-        cl[k, CL_W + c] *= dark
-        total += dark
-    cl[k, CL_SW] *= total * (1.0 / 3.0)
+    inv_energy = 1.0 / energy
+    # channels of equal Fss (a white tint: the Principled's specular) share one evaluation
+    dark_r = _darkening(fss_r, e_avg, missing, inv_energy)
+    dark_g = dark_r if fss_g == fss_r else _darkening(fss_g, e_avg, missing, inv_energy)
+    dark_b = dark_g if fss_b == fss_g else _darkening(fss_b, e_avg, missing, inv_energy)
+    cl[k, CL_W] *= dark_r
+    cl[k, CL_W + 1] *= dark_g
+    cl[k, CL_W + 2] *= dark_b
+    cl[k, CL_SW] *= (dark_r + dark_g + dark_b) * (1.0 / 3.0)
+
+
+@device
+def _darkening(fss, e_avg, missing, inv_energy):
+    """Kulla-Conty: (1 + Fms (1 - E) / E) / energy with Fms = Fss E_avg / (1 - Fss (1 - E_avg))."""
+    fms = fss * e_avg / (1.0 - fss * (1.0 - e_avg))
+    return (1.0 + fms * missing) * inv_energy
 
 
 microfacet_estimate_albedo = microfacet_albedo     # Cycles' name

@@ -253,6 +253,23 @@ def test_preserve_energy_darkening_is_kulla_conty():
 
 
 @needs_tables
+@pytest.mark.parametrize("fss", [(0.5, 0.5, 0.5), (1.0, 1.0, 0.5), (0.3, 0.6, 0.6), (0.2, 0.7, 0.2),
+                                 (0.9, 0.4, 0.1)])
+def test_preserve_energy_darkens_each_channel_by_its_own_fss(fss):
+    """Channels of equal Fss share one evaluation; each still gets Kulla-Conty's factor of
+    its own Fss, and the sample weight their mean."""
+    mu = 0.6
+    cl = microfacet_row(alpha=0.3)
+    cl[0, CL_W:CL_W + 3] = (0.5, 0.25, 1.0)
+    cl[0, CL_SW] = 0.8
+    mf.microfacet_preserve_energy(cl, 0, mu, *fss)
+    e, e_avg = mf.microfacet_albedo_tables(cl, 0, mu)
+    dark = [(1 + f * e_avg / (1 - f * (1 - e_avg)) * (1 - e) / e) * e for f in fss]
+    assert cl[0, CL_W:CL_W + 3] == pytest.approx(np.array([0.5, 0.25, 1.0]) * dark, rel=1e-12)
+    assert cl[0, CL_SW] == pytest.approx(0.8 * np.mean(dark), rel=1e-12)
+
+
+@needs_tables
 def test_albedo_estimate():
     """Cycles' bsdf_microfacet_estimate_albedo: tables for the Schlick/F82/dielectric
     reflection, smooth (1 - F) tint for the transmission; the sample weight follows it."""

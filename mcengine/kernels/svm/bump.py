@@ -31,7 +31,7 @@ import math
 
 from ...jit import device, function
 from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
-from .input_nodes import normal_to_object, normal_to_world, transform_direction, transform_point
+from .input_nodes import attribute, normal_to_object, normal_to_world, transform_direction, transform_point
 from .math_nodes import safe_normalize
 from .nodes import OFFSETS, SPACE_OBJECT
 
@@ -160,10 +160,7 @@ def undisplaced_point(sd, verts, tris, regs, s, axis, tex):
                                         dua * e1z + dva * e2z)
     dyx, dyy, dyz = transform_direction(row, OBJ_MATRIX, dub * e1x + dvb * e2x, dub * e1y + dvb * e2y,
                                         dub * e1z + dvb * e2z)
-    b0 = 1.0 - u - v
-    nx = b0 * float(a[p, 0, off_n]) + u * float(a[p, 1, off_n]) + v * float(a[p, 2, off_n])
-    ny = b0 * float(a[p, 0, off_n + 1]) + u * float(a[p, 1, off_n + 1]) + v * float(a[p, 2, off_n + 1])
-    nz = b0 * float(a[p, 0, off_n + 2]) + u * float(a[p, 1, off_n + 2]) + v * float(a[p, 2, off_n + 2])
+    nx, ny, nz, _ = attribute(tex, sd, off_n, 3)
     nx, ny, nz = normal_to_world(row, nx, ny, nz)
     if sd.backfacing:
         nx, ny, nz = -nx, -ny, -nz

@@ -123,8 +123,6 @@ CASES = {
 }
 
 
-
-
 @pytest.fixture(scope="module")
 def images():
     return render_cases(CASES)

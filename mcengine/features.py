@@ -19,6 +19,10 @@ transparent shadows  a material lets shadow rays through      shadow rays traced
 caustic paths        lights, a glossy/glass/refraction caster Filter Glossy and the caustics switches
                      and a diffuse receiver                   at every vertex; the light paths of
                                                               Path + Light Tracing
+subsurface walks     a material has a subsurface closure      a hierarchy over each such object's
+                     (Principled Subsurface Weight, the       triangles; random walks inside them
+                     Subsurface Scattering node)              (without it: Lambert, the zero-radius
+                                                              limit)
 ==================== ======================================== ======================================
 
 The camera's effects cost nothing when absent without a flag: no lens sample is
@@ -50,6 +54,7 @@ from .kernels.state import (
     CFG_LAMPS_HIT,
     CFG_LIGHTS,
     CFG_MIS,
+    CFG_SUBSURFACE,
     CFG_TRANSPARENT_SHADOWS,
     CFG_WORLD,
     MF_TRANSPARENT,
@@ -66,6 +71,7 @@ EFFECTS = {
     "world": ("world lookups", CFG_WORLD),
     "transparent_shadows": ("transparent shadows", CFG_TRANSPARENT_SHADOWS),
     "caustics": ("caustic paths", CFG_CAUSTICS),
+    "subsurface": ("subsurface walks", CFG_SUBSURFACE),
 }
 
 
@@ -87,6 +93,7 @@ class EffectsPlan:
     world: bool = False
     transparent_shadows: bool = False
     caustics: bool = False
+    subsurface: bool = False
     forced: tuple = ()             # effects forced on although the scene does not call for them
 
     def force(self, names) -> "EffectsPlan":
@@ -159,7 +166,7 @@ def lamps_hit_by_rays(lights) -> bool:
 
 CASTERS = {"rough glossy", "sharp glossy", "coat", "rough glass", "sharp glass",
            "rough refraction", "sharp refraction"}
-RECEIVERS = {"diffuse", "rough diffuse", "sheen", "translucent"}
+RECEIVERS = {"diffuse", "rough diffuse", "sheen", "translucent", "subsurface"}
 
 
 def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=None,
@@ -198,6 +205,7 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         nee=nee,
         mis=nee and (lamps_hit or emissive_triangles > 0 or world_sampled),
         caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
+        subsurface="subsurface" in kinds,
     )
 
 
@@ -228,7 +236,8 @@ def camera_effects(scene) -> tuple:
     return tuple(out)
 
 
-LOBE_ORDER = ("diffuse", "rough diffuse", "sheen", "translucent", "rough glossy", "sharp glossy",
+LOBE_ORDER = ("diffuse", "rough diffuse", "subsurface", "sheen", "translucent", "rough glossy",
+              "sharp glossy",
               "coat", "rough glass", "sharp glass", "rough refraction", "sharp refraction",
               "transparent", "emission", "holdout")
 # Roughness below which a microfacet lobe is a perfect mirror (alpha_x alpha_y <= 2e-10).
@@ -278,6 +287,8 @@ def surface_kinds(material) -> set:
             kinds.add("sharp glass" if sharp("Roughness", 0.0) else "rough glass")
         elif kind == "BsdfRefraction":
             kinds.add("sharp refraction" if sharp("Roughness", 0.0) else "rough refraction")
+        elif kind == "SubsurfaceScattering":
+            kinds.add("subsurface")
         elif kind in ("BsdfTranslucent", "BsdfTransparent", "BsdfSheen", "Emission", "Holdout"):
             kinds.add({"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent",
                        "BsdfSheen": "sheen", "Emission": "emission", "Holdout": "holdout"}[kind])
@@ -285,7 +296,10 @@ def surface_kinds(material) -> set:
             rough = "sharp" if sharp("Roughness", 0.5) else "rough"
             if below_one("Metallic", 0.0) and below_one("Transmission Weight", 0.0) \
                     and positive("Base Color", (0.8,) * 3):
-                kinds.add("rough diffuse" if positive("Diffuse Roughness", 0.0) else "diffuse")
+                if below_one("Subsurface Weight", 0.0):
+                    kinds.add("rough diffuse" if positive("Diffuse Roughness", 0.0) else "diffuse")
+                if positive("Subsurface Weight", 0.0):
+                    kinds.add("subsurface")
             if positive("Metallic", 0.0) or positive("Specular IOR Level", 0.5):
                 kinds.add(f"{rough} glossy")
             if positive("Transmission Weight", 0.0):

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import cryptomatte, integrators, samplers
 from .background import map_size, world_map
-from .features import EffectsPlan, lamps_intersectable
+from .features import EffectsPlan, lamps_intersectable, surface_kinds
 from .features import detect as detect_plan
 from .images import ImageTable
 from .kernels.camera import pack_camera
@@ -61,6 +61,7 @@ from .kernels.state import (
     SceneData,
     alloc_scratch,
 )
+from .kernels.subsurface import build_local_bvh, no_local_bvh
 from .kernels.svm import (
     OBJ_COLOR,
     OBJ_HOLDOUT,
@@ -146,7 +147,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
                         objects=pack_objects(g), camera=camera, images=images.info,
                         pix8=images.pix8, pixf=images.pixf),
         motion=pack_motion(g, scene.motion_blur.objects if scene.motion_blur else []),
-        bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)), bg_sun=np.zeros(5))
+        bg_marginal=np.zeros(2), bg_conditional=np.zeros((1, 2)), bg_sun=np.zeros(5),
+        local=no_local_bvh())
 
     # The world as a light: its importance map, when its radiance varies.
     world_importance = world_power = 0.0
@@ -206,6 +208,14 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
                         world_power > 0.0), len(images.slots))
     if force_effects:
         plan = plan.force(force_effects)
+
+    if plan.subsurface and len(tris):
+        # The objects a subsurface walk may run in: those with a subsurface material.
+        walked = [i for i, mat in enumerate(scene.materials) if "subsurface" in surface_kinds(mat)]
+        tri_object = sc.tex.tri_object
+        sc = sc._replace(local=build_local_bvh(
+            verts, tris, tri_object, sc.tex.objects.shape[0],
+            np.unique(tri_object[np.isin(mat_index, walked)])))
 
     x0, y0, x1, y1 = film.window
     sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,

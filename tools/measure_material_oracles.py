@@ -21,8 +21,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from tests.core.material_oracles import (  # noqa: E402
+    ALL_ORACLES,
     LIGHT_WATTS,
-    ORACLES,
+    SUBSURFACE_ORACLES,
     camera_matrix,
     light_position,
 )
@@ -30,19 +31,21 @@ from tests.core.material_oracles import (  # noqa: E402
 OUT = REPO / "tests" / "core" / "material_oracles.json"
 SAMPLES_LIGHT = 1024   # Cycles' first sample per pixel loses some light through transmission NEE
 SAMPLES_FURNACE = 4096
+SAMPLES_SUBSURFACE = 16384   # random walks: the standard error over the pixels goes with them
 RESOLUTION = 8
 ORTHO_SCALE = 0.02
 NODE_IDS = {"BsdfGlossy": "ShaderNodeBsdfAnisotropic"}
 
 
 def build(bpy, name):
-    nodes, view, light = ORACLES[name]
+    nodes, view, light = ALL_ORACLES[name]
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
-    c.samples = SAMPLES_FURNACE if light is None else SAMPLES_LIGHT
+    c.samples = (SAMPLES_SUBSURFACE if name in SUBSURFACE_ORACLES
+                 else SAMPLES_FURNACE if light is None else SAMPLES_LIGHT)
     c.use_denoising = c.use_adaptive_sampling = False
     c.seed = 0
     c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
@@ -111,18 +114,23 @@ def render(bpy, scene, path):
     bpy.ops.render.render(write_still=True)
     with OpenEXR.File(str(path)) as f:
         px = np.asarray(f.channels()["RGBA"].pixels, np.float64)
-    return [float(v) for v in px.reshape(-1, 4).mean(axis=0)]
+    px = px.reshape(-1, 4)
+    # The standard error of the mean from the pixels' spread (each pixel an independent mean).
+    se = px.std(axis=0, ddof=1) / np.sqrt(len(px))
+    return [float(v) for v in px.mean(axis=0)], [float(v) for v in se]
 
 
 def main(argv=None) -> int:
     import bpy
-    names = (argv if argv is not None else sys.argv[1:]) or list(ORACLES)
+    names = (argv if argv is not None else sys.argv[1:]) or list(ALL_ORACLES)
     results = json.loads(OUT.read_text()) if OUT.exists() else {}
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             scene = build(bpy, name)
-            rgba = render(bpy, scene, Path(tmp) / f"{name}.exr")
+            rgba, se = render(bpy, scene, Path(tmp) / f"{name}.exr")
             results[name] = {"rgba": rgba, "samples": scene.cycles.samples}
+            if name in SUBSURFACE_ORACLES:
+                results[name]["se"] = se
             print(f"{name}: {rgba}", flush=True)
     OUT.write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
     return 0

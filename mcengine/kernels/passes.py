@@ -49,6 +49,7 @@ from .closures.layout import (
     CL_SW,
     CL_TYPE,
     CL_W,
+    CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
@@ -466,7 +467,7 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
     if c[P_DIFFUSE_COLOR] >= 0 or c[P_GLOSSY_COLOR] >= 0 or c[P_TRANSMISSION_COLOR] >= 0:
         for k in range(ncl):
             t = cl[k, CL_TYPE]
-            if is_diffuse(t):
+            if is_diffuse(t) or t == CT_BSSRDF:    # Cycles' surface_shader_diffuse
                 o, refl, trans = c[P_DIFFUSE_COLOR], True, True
             elif t == CT_MICROFACET:
                 o, refl, trans = c[P_GLOSSY_COLOR], True, False

@@ -30,12 +30,27 @@ import math
 
 import numpy as np
 
-from ..jit import device, kernel
+from ..jit import device, function, kernel
 from .camera import generate_camera_rays
 from .closures.layout import (
+    CL_ANISOTROPY,
     CL_AX,
     CL_AY,
+    CL_BUMP_CORRECTION,
+    CL_ENERGY,
+    CL_N,
+    CL_NS,
+    CL_RADIUS,
+    CL_SSS_ALBEDO,
+    CL_SSS_BUMP,
+    CL_SSS_METHOD,
+    CL_STRIDE,
+    CL_SW,
+    CL_TERMINATOR,
     CL_TYPE,
+    CL_W,
+    CT_BSSRDF,
+    CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
@@ -43,9 +58,11 @@ from .closures.layout import (
     LABEL_DIFFUSE,
     LABEL_REFLECT,
     LABEL_SINGULAR,
+    LABEL_SUBSURFACE,
     LABEL_TRANSPARENT,
+    SSS_BURLEY,
 )
-from .intersect import offset_origin
+from .intersect import offset_origin, offset_scale
 from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
 from .passes import (
     LK_BACKGROUND,
@@ -71,9 +88,11 @@ from .sampling import (
     SET_LIGHT,
     SET_TERMINATE,
     bounce_set,
+    exit_key,
     sample_1d,
     sample_2d,
     sample_4d,
+    walk_key,
 )
 from .shading import (
     direct_light,
@@ -102,14 +121,18 @@ from .state import (
     CFG_MIS,
     CFG_SAMPLER,
     CFG_SOBOL_MASK,
+    CFG_SUBSURFACE,
     FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     FCFG_WORLD_IMPORTANCE,
+    MF_BUMP_CORRECTION,
+    MF_CLOSURES_ONLY,
     MF_EMISSIVE,
     PF_CAMERA,
     PF_CAUSTIC_EYE,
     PF_DENOISE,
     PF_MIS_SKIP,
+    PF_SUBSURFACE,
     PF_SURFACE_PASS,
     PF_TERMINATE,
     PF_TRANSPARENT,
@@ -122,8 +145,9 @@ from .state import (
     ST_SELF_HITS,
     move_path,
 )
+from .subsurface import disk_probe, random_walk
 from .surface import hit_distance, past_self_hit, surface_point
-from .svm import OBJ_HOLDOUT
+from .svm import OBJ_HOLDOUT, OBJ_TERMINATOR_SHADING
 
 
 # -- 3. shading ---------------------------------------------------------------------------------
@@ -168,19 +192,24 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     world_importance = fcfg[FCFG_WORLD_IMPORTANCE]
     max_transparent = cfg[CFG_MAX_TRANSPARENT]
     sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
+    walks = cfg[CFG_SUBSURFACE] != 0
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
         ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
         dx, dy, dz = st.ray_d[i, 0], st.ray_d[i, 1], st.ray_d[i, 2]
-        if p >= 0 and p == st.self_prim[i]:
+        flags = st.flags[i]
+        # Where a subsurface walk left its object: that triangle, whatever the ray met.
+        exit_walk = (flags & PF_SUBSURFACE) != 0
+        if exit_walk:
+            p = st.self_prim[i]
+        elif p >= 0 and p == st.self_prim[i]:
             stats[ST_SELF_HITS] += 1
             s = past_self_hit(sc, p, ox, oy, oz, dx, dy, dz, st.time[i])
             set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
                     ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, st.ray_tmax[i] - s)
             st.alive[i] = 1
             continue
-        flags = st.flags[i]
         mis_pdf = st.mis_pdf[i]
         t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i], st.time[i])
         direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
@@ -192,7 +221,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                           mpx, mpy, mpz)
 
         # -- light arriving along the ray ------------------------------------------------------
-        if lamps_hit:
+        if lamps_hit and not exit_walk:
             if light_passes:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             passed = light_from_lamps(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i,
@@ -232,64 +261,75 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
         depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
         footprint = st.dp[i] + st.dd[i] * ray_length     # Cycles' differential_transfer_compact
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
-                          not terminate, depths, footprint)
-
-        # Holdout: the film's alpha drops by the holdout weight on camera paths. A holdout
-        # object's weight is its opacity, 1 - transparency; only its transparent closure
-        # stays, without emission (Cycles' surface_shader_apply_holdout).
-        ncl = res.n
-        emits = res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0
-        if flags & PF_TRANSPARENT_BG:
-            if sc.tex.objects[sc.tex.tri_object[p], OBJ_HOLDOUT] > 0.0:
-                ncl = _keep_transparent(scratch.cl, ncl)
-                emits = False
-                hr, hg, hb = max(1.0 - res.tr, 0.0), max(1.0 - res.tg, 0.0), max(1.0 - res.tb, 0.0)
-            else:
-                hr = hg = hb = res.holdout
-            if hr > 0.0 or hg > 0.0 or hb > 0.0:
-                st.transparency[i] += (hr * st.beta[i, 0] + hg * st.beta[i, 1] + hb * st.beta[i, 2]) / 3.0
-                if hr >= 1.0 and hg >= 1.0 and hb >= 1.0:
-                    continue
-        # Emission (two-sided).
-        if emits:
-            if light_passes:
-                r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
-            light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
-                               ray_length, sp, flags, mis_pdf,
-                               pmf_mode, mpx, mpy, mpz, mis_total, direct, res.er, res.eg, res.eb)
-            if light_passes:
-                _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
-        if terminate or ncl == 0:
-            continue
-        if caustics and fcfg[FCFG_FILTER_GLOSSY] > 0.0:
-            blur_closures(scratch.cl, ncl, fcfg[FCFG_FILTER_GLOSSY] * st.min_pdf[i])
-
-        # Russian roulette (Cycles: from the third vertex on, with the
-        # throughput as it is; emission here is not affected by it).
         bounce = st.bounce[i]
         vertex = bounce + st.transparent[i]      # random-number dimensions of this vertex
-        key = st.key[i]
-        if bounce > cfg[CFG_MIN_LIGHT_BOUNCES] + 1:
-            q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))), 1.0)
-            if q < 1.0:
-                if sample_1d(sampler, key, bounce_set(vertex, SET_TERMINATE), mask) >= q:
-                    continue
-                st.beta[i, 0] /= q
-                st.beta[i, 1] /= q
-                st.beta[i, 2] /= q
-
-        # -- render passes written at the surface (data passes, denoising features) ------------
-        if surface_pass_work:
-            flags = surface_passes(pd, fp, st.pixel[i], flags, sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy,
-                                   sp.nsz, t_hit, p, b1, b2, m, scratch.cl, ncl, st.beta[i, 0],
-                                   st.beta[i, 1], st.beta[i, 2], res.tr, res.tg, res.tb,
-                                   -dx, -dy, -dz, pb, i)
+        if exit_walk:
+            # A walk's exit: one Lambert closure, no emission, holdout, Russian roulette or
+            # data passes (Cycles shades it so); the path keeps its bounce counts.
+            ncl = _exit_closure(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length,
+                                flags, depths, footprint)
+            flags &= ~PF_SUBSURFACE
             st.flags[i] = flags
+            rtr = rtg = rtb = 0.0
+        else:
+            res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
+                              not terminate, depths, footprint, walks)
+            ncl, rtr, rtg, rtb = res.n, res.tr, res.tg, res.tb
+
+            # Holdout: the film's alpha drops by the holdout weight on camera paths. A holdout
+            # object's weight is its opacity, 1 - transparency; only its transparent closure
+            # stays, without emission (Cycles' surface_shader_apply_holdout).
+            emits = res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0
+            if flags & PF_TRANSPARENT_BG:
+                if sc.tex.objects[sc.tex.tri_object[p], OBJ_HOLDOUT] > 0.0:
+                    ncl = _keep_transparent(scratch.cl, ncl)
+                    emits = False
+                    hr, hg, hb = max(1.0 - rtr, 0.0), max(1.0 - rtg, 0.0), max(1.0 - rtb, 0.0)
+                else:
+                    hr = hg = hb = res.holdout
+                if hr > 0.0 or hg > 0.0 or hb > 0.0:
+                    st.transparency[i] += (hr * st.beta[i, 0] + hg * st.beta[i, 1]
+                                           + hb * st.beta[i, 2]) / 3.0
+                    if hr >= 1.0 and hg >= 1.0 and hb >= 1.0:
+                        continue
+            # Emission (two-sided).
+            if emits:
+                if light_passes:
+                    r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
+                light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
+                                   ray_length, sp, flags, mis_pdf, pmf_mode, mpx, mpy, mpz,
+                                   mis_total, direct, res.er, res.eg, res.eb)
+                if light_passes:
+                    _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
+            if terminate or ncl == 0:
+                continue
+            if caustics and fcfg[FCFG_FILTER_GLOSSY] > 0.0:
+                blur_closures(scratch.cl, ncl, fcfg[FCFG_FILTER_GLOSSY] * st.min_pdf[i])
+
+            # Russian roulette (Cycles: from the third vertex on, with the
+            # throughput as it is; emission here is not affected by it).
+            if bounce > cfg[CFG_MIN_LIGHT_BOUNCES] + 1:
+                q = min(math.sqrt(max(abs(st.beta[i, 0]), abs(st.beta[i, 1]), abs(st.beta[i, 2]))),
+                        1.0)
+                if q < 1.0:
+                    if sample_1d(sampler, st.key[i], bounce_set(vertex, SET_TERMINATE), mask) >= q:
+                        continue
+                    st.beta[i, 0] /= q
+                    st.beta[i, 1] /= q
+                    st.beta[i, 2] /= q
+
+            # -- render passes written at the surface (data passes, denoising features) --------
+            if surface_pass_work:
+                flags = surface_passes(pd, fp, st.pixel[i], flags, sp.hx, sp.hy, sp.hz, sp.nsx,
+                                       sp.nsy, sp.nsz, t_hit, p, b1, b2, m, scratch.cl, ncl,
+                                       st.beta[i, 0], st.beta[i, 1], st.beta[i, 2], rtr, rtg, rtb,
+                                       -dx, -dy, -dz, pb, i)
+                st.flags[i] = flags
+        key = st.key[i]
         if ao and (flags & PF_CAMERA):
             au, av = sample_2d(sampler, key, bounce_set(vertex, SET_AO), mask)
             n_shadow = queue_ao_ray(pd, sc, scratch, sq, n_shadow, i, ncl, sp, st.beta[i, 0],
-                                    st.beta[i, 1], st.beta[i, 2], res.tr, res.tg, res.tb, au, av,
+                                    st.beta[i, 1], st.beta[i, 2], rtr, rtg, rtb, au, av,
                                     depths, max_transparent - st.transparent[i])
 
         # -- next-event estimation: one light --------------------------------------------------
@@ -325,6 +365,15 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         st.beta[i, 0] *= ds.wr
         st.beta[i, 1] *= ds.wg
         st.beta[i, 2] *= ds.wb
+        if ds.label & LABEL_SUBSURFACE:
+            # Into the object: walk to where the light leaves it (Cycles' subsurface_bounce
+            # and subsurface_scatter; no bounce is counted).
+            if split and bounce == 0:
+                pb.pw[i, 0] = pb.pw[i, 1] = pb.pw[i, 2] = 1.0
+                pb.pw[i, 3] = pb.pw[i, 4] = pb.pw[i, 5] = 0.0
+            if _walk(sc, st, i, scratch.cl, ds.pick, p, sp, ds.wix, ds.wiy, ds.wiz, vertex):
+                st.alive[i] = 1
+            continue
         if ds.label & LABEL_TRANSPARENT:
             # Straight through: a transparent bounce, the path keeps its flags and MIS data.
             st.transparent[i] += 1
@@ -352,6 +401,85 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         st.self_prim[i] = p
         st.alive[i] = 1
     return n_shadow
+
+
+@function
+def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex):
+    """Take path i from ``sp`` on triangle p to where BSSRDF closure k lets the light out of
+    the object: a random walk along wi, or Christensen-Burley's disk probe; returns whether
+    it found an exit.  Then its ray comes from outside to the exit triangle (the next
+    ``shade`` shades the exit there, ``PF_SUBSURFACE``) and its key changes, so the exit
+    draws other numbers than the entry (``sampling.exit_key``)."""
+    obj = sc.tex.tri_object[p]
+    if obj >= sc.local.root.shape[0]:
+        return False
+    wkey = walk_key(st.key[i], vertex)
+    if cl[k, CL_SSS_METHOD] == SSS_BURLEY:
+        left, q, ex, ey, ez, gx, gy, gz, wr, wg, wb = disk_probe(
+            sc.local, sc.verts, sc.tris, sc.normals, sc.tri_normal, obj, wkey, sp.hx, sp.hy,
+            sp.hz, sp.ngx, sp.ngy, sp.ngz, sp.backfacing, cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
+            cl[k, CL_RADIUS + 2])
+        if not left:
+            return False
+        tr, tg, tb = st.beta[i, 0] * wr, st.beta[i, 1] * wg, st.beta[i, 2] * wb
+        ddx, ddy, ddz, t = gx, gy, gz, 0.5     # the exit faces its normal
+    else:
+        left, q, ex, ey, ez, ddx, ddy, ddz, t, tr, tg, tb = random_walk(
+            sc.local, sc.verts, sc.tris, obj, wkey, sp.hx, sp.hy, sp.hz, wix, wiy, wiz,
+            sp.nsx, sp.nsy, sp.nsz, p, cl[k, CL_SSS_ALBEDO], cl[k, CL_SSS_ALBEDO + 1],
+            cl[k, CL_SSS_ALBEDO + 2], cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
+            cl[k, CL_RADIUS + 2], cl[k, CL_ANISOTROPY], st.beta[i, 0], st.beta[i, 1],
+            st.beta[i, 2])
+        if not left:
+            return False
+    st.beta[i, 0], st.beta[i, 1], st.beta[i, 2] = tr, tg, tb
+    # Cycles' trick for the exit's normals: a ray from outside, twice the last step away
+    # (the walk arrived along dd; the disk's exit faces its normal).
+    s = max(2.0 * t, offset_scale(ex, ey, ez))
+    set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+            ex + s * ddx, ey + s * ddy, ez + s * ddz, -ddx, -ddy, -ddz, s)
+    st.self_prim[i] = q
+    st.key[i] = exit_key(st.key[i], vertex)
+    st.flags[i] = (st.flags[i] & ~PF_CAMERA) | PF_SUBSURFACE
+    return True
+
+
+@function
+def _exit_closure(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags, depths,
+                  footprint):
+    """The closure list at a walk's exit (Cycles' subsurface_shader_data_setup): one Lambert
+    closure of weight 1 about the smooth normal, or, when a BSSRDF of the material there
+    takes a linked Normal input, about its BSSRDFs' normals averaged by weight (the
+    material's shader runs only then: materials of constant closures have no such input).
+    Returns the count, 1."""
+    cl = scratch.cl
+    nx, ny, nz = sp.nsx, sp.nsy, sp.nsz
+    if not (sc.mat_flags[m] & MF_CLOSURES_ONLY):
+        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
+                          True, depths, footprint, True)
+        bump = False
+        ax = ay = az = 0.0
+        for k in range(res.n):
+            if cl[k, CL_TYPE] == CT_BSSRDF:
+                w = abs(cl[k, CL_W] + cl[k, CL_W + 1] + cl[k, CL_W + 2]) / 3.0
+                ax += cl[k, CL_N] * w
+                ay += cl[k, CL_N + 1] * w
+                az += cl[k, CL_N + 2] * w
+                bump = bump or cl[k, CL_SSS_BUMP] != 0.0
+        length = math.sqrt(ax * ax + ay * ay + az * az)
+        if bump and length > 0.0:
+            nx, ny, nz = ax / length, ay / length, az / length
+    for c in range(CL_STRIDE):
+        cl[0, c] = 0.0
+    cl[0, CL_TYPE] = CT_DIFFUSE
+    cl[0, CL_W] = cl[0, CL_W + 1] = cl[0, CL_W + 2] = cl[0, CL_SW] = cl[0, CL_ENERGY] = 1.0
+    cl[0, CL_N], cl[0, CL_N + 1], cl[0, CL_N + 2] = nx, ny, nz
+    cl[0, CL_NS], cl[0, CL_NS + 1], cl[0, CL_NS + 2] = sp.nsx, sp.nsy, sp.nsz
+    cl[0, CL_BUMP_CORRECTION] = 1.0 if sc.mat_flags[m] & MF_BUMP_CORRECTION else 0.0
+    frequency = sc.tex.objects[sc.tex.tri_object[p], OBJ_TERMINATOR_SHADING]
+    if frequency > 1.0:
+        cl[0, CL_TERMINATOR] = frequency
+    return 1
 
 
 @device

@@ -61,6 +61,7 @@ _M32 = np.uint64(0xFFFFFFFF)
 _INV_2_53 = 1.0 / 9007199254740992.0
 _K_SEED_B = np.uint64(0x5851F42D4C957F2D)   # any odd 64-bit constants
 _K_SEED_C = np.uint64(0x14057B7EF767814F)
+_K_WALK = np.uint64(0x2545F4914F6CDD1D)
 
 
 @device
@@ -84,6 +85,22 @@ def rand(key, dim):
     """Uniform float64 in [0, 1) for dimension ``dim`` of the path ``key``."""
     h = mix64(key ^ (np.uint64(dim + 1) * _K_DIM))
     return float(h >> np.uint64(11)) * _INV_2_53
+
+
+@device
+def walk_key(key, vertex):
+    """Key of the independent numbers of a subsurface walk from path vertex ``vertex``."""
+    return mix64(key ^ (np.uint64(vertex + 1) * _K_WALK))
+
+
+@device
+def exit_key(key, vertex):
+    """The key a path continues with after a subsurface walk from vertex ``vertex``: the
+    walk's exit is shaded as a vertex of the same number, so its numbers (and those of the
+    vertices after it) need other scrambles (the key's high bits); the sample index (low
+    bits) stays, so the Sobol sampler stays stratified over the pixel's samples."""
+    h = mix64((key >> np.uint64(SAMPLE_BITS)) ^ (np.uint64(vertex + 1) * _K_WALK))
+    return key ^ (h << np.uint64(SAMPLE_BITS))
 
 
 @device

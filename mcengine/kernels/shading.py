@@ -43,7 +43,7 @@ from .closures import (
     bsdf_eval,
     bsdf_sample_closure,
 )
-from .closures.layout import CL_TERMINATOR
+from .closures.layout import CL_SW, CL_TERMINATOR, CL_TYPE, CL_W, CT_BSSRDF, CT_DIFFUSE
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
     PMF_EVERY,
@@ -75,6 +75,7 @@ from .state import (
     MF_EMISSION_VARIES,
     PF_CAMERA,
     PF_DIFFUSE,
+    PF_DIFFUSE_ANCESTOR,
     PF_EMISSION,
     PF_GLOSSY,
     PF_MIS_SKIP,
@@ -237,7 +238,7 @@ def next_path_flags(flags, label):
                     PF_GLOSSY | PF_SINGULAR | PF_TRANSMIT | PF_REFLECT | PF_TERMINATE)
     new |= PF_REFLECT if label & LABEL_REFLECT else PF_TRANSMIT
     if label & LABEL_DIFFUSE:
-        new |= PF_DIFFUSE
+        new |= PF_DIFFUSE | PF_DIFFUSE_ANCESTOR
     elif label & LABEL_GLOSSY:
         new |= PF_GLOSSY
     else:   # singular: a glossy ray for light visibility, no MIS at its hit
@@ -342,7 +343,7 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
 
 @device
 def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths,
-                footprint):
+                footprint, walks=False):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
     direction d and length t_hit (from the vertex it left, through transparent surfaces, as
     Cycles measures it), on a path with ``flags`` and ``depths`` (bounces: all, diffuse,
@@ -351,7 +352,9 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
 
     The closures go to ``scratch.cl``, each with the object's Shadow Terminator Shading
     Offset (``closures.shift_cos_in``); returns the ``ShaderResult``.  With
-    ``allocate`` false only emission, transparency and holdout are computed.
+    ``allocate`` false only emission, transparency and holdout are computed.  BSSRDF
+    closures stay for a caller that ``walks`` (the path tracer with subsurface walks on);
+    for others they become Lambert closures of their weight (Cycles' zero-radius limit).
     """
     from_diffuse = (flags & PF_DIFFUSE) != 0
     obj = sc.tex.tri_object[p]
@@ -366,6 +369,12 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
     else:
         res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                           scratch.cl, sd, sc.tex, sc.verts, sc.tris)
+    if not walks:
+        for k in range(res.n):
+            if scratch.cl[k, CL_TYPE] == CT_BSSRDF:
+                scratch.cl[k, CL_TYPE] = CT_DIFFUSE
+                scratch.cl[k, CL_SW] = abs(scratch.cl[k, CL_W] + scratch.cl[k, CL_W + 1]
+                                           + scratch.cl[k, CL_W + 2]) / 3.0
     frequency = sc.tex.objects[obj, OBJ_TERMINATOR_SHADING]
     if frequency > 1.0:
         for k in range(res.n):

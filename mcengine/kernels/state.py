@@ -105,6 +105,7 @@ SceneData = namedtuple("SceneData", [
     "bg_conditional",  # (H, W + 1) f64  CDF over the columns of each row (kernels.background)
     "bg_sun",        # (5,) f64     a sun cone sampled beside the map: direction, cos of its
                      #              half angle, the share of world samples it gets (0: none)
+    "local",         # kernels.subsurface.LocalBVH: each subsurface object's own triangles
 ])
 
 # Material flags (mat_flags).
@@ -134,6 +135,10 @@ PF_SINGULAR = 16384       # the ray was made by a singular (perfectly sharp) lob
 PF_EMISSION = 32768       # shading a light sample's emission (Cycles' PATH_RAY_EMISSION)
 PF_CAUSTIC_EYE = 65536    # the camera ray's first surface scattered it through a lobe that is not
                           # singular: its caustic paths may be light tracing's (``light_tracing``)
+PF_SUBSURFACE = 131072    # the ray ends where a subsurface walk left the object: ``self_prim`` is
+                          # that triangle, shaded there as Lambert (Cycles' PATH_RAY_SUBSURFACE)
+PF_DIFFUSE_ANCESTOR = 262144  # a diffuse bounce happened on the path (Cycles'
+                              # PATH_RAY_DIFFUSE_ANCESTOR: Christensen-Burley turns Lambert)
 
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
@@ -162,7 +167,8 @@ CFG_SAMPLER = 22          # sampling.SAMPLER_*: which numbers paths draw
 CFG_SOBOL_MASK = 23       # mask of the Sobol sampler's shuffled sample index (sobol.index_mask)
 CFG_WORLD_SHADER = 24     # the background varies (textures, ray types): run the world's shader
 CFG_LIGHT_TRACING = 25    # light tracing renders the caustics of the LF_LIGHT_TRACED lamps
-CFG_SIZE = 26
+CFG_SUBSURFACE = 26       # BSSRDF closures walk inside their objects (else they are Lambert)
+CFG_SIZE = 27
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1

@@ -29,7 +29,8 @@ def test_f12_renders_with_the_real_core(scene, render_exr):
     np.testing.assert_allclose(image[8:], np.broadcast_to([0, 0, 0, 1], (4, 16, 4)), atol=1e-7)
     assert scene.mcengine.last_effects == (
         "Lights: 2 emissive triangles; surfaces: emission; no textures | simulated: light sampling, "
-        "MIS weights | skipped: lamp hits, world lookups, transparent shadows, caustic paths")
+        "MIS weights | skipped: lamp hits, world lookups, transparent shadows, caustic paths, "
+        "subsurface walks")
 
 
 def test_frames_with_the_same_triangles_reuse_the_bvh(scene, addon):

@@ -90,6 +90,33 @@ ORACLES = {
                                    30.0, None),
 }
 
+# Subsurface scattering: random walks are noisy even under a point light, so these are
+# compared channel by channel within both renders' standard errors (test_subsurface.py);
+# the plane is then the top of a half-space of the medium.
+SUBSURFACE_ORACLES = {
+    "subsurface_furnace": ([("BsdfPrincipled", {"Base Color": (0.8, 0.4, 0.1), "Subsurface Weight": 1.0,
+                                                "Specular IOR Level": 0.0}, {})], 30.0, None),
+    "subsurface_skin_furnace": ([("BsdfPrincipled", {"Base Color": (0.8, 0.4, 0.1),
+                                                     "Subsurface Weight": 1.0,
+                                                     "Specular IOR Level": 0.0},
+                                  {"subsurface_method": "RANDOM_WALK_SKIN"})], 30.0, None),
+    "subsurface_node_furnace": ([("SubsurfaceScattering", {"Color": (0.9, 0.6, 0.3), "Anisotropy": 0.6,
+                                                           "Roughness": 0.5}, {})], 30.0, None),
+    "subsurface_point": ([("BsdfPrincipled", {"Base Color": (0.8, 0.5, 0.3), "Subsurface Weight": 1.0,
+                                              "Subsurface Scale": 0.2}, {})], 30.0, (20.0, 180.0)),
+    "subsurface_half_point": ([("BsdfPrincipled", {"Base Color": (0.3, 0.6, 0.9),
+                                                   "Subsurface Weight": 0.5, "Roughness": 0.3,
+                                                   "Subsurface Anisotropy": 0.3}, {})],
+                              45.0, (45.0, 0.0)),
+    "subsurface_burley_furnace": ([("BsdfPrincipled", {"Base Color": (0.8, 0.4, 0.1),
+                                                       "Subsurface Weight": 1.0,
+                                                       "Specular IOR Level": 0.0},
+                                    {"subsurface_method": "BURLEY"})], 30.0, None),
+    "subsurface_burley_point": ([("SubsurfaceScattering", {"Color": (0.9, 0.6, 0.3), "Scale": 0.2},
+                                  {"falloff": "BURLEY"})], 30.0, (20.0, 180.0)),
+}
+ALL_ORACLES = {**ORACLES, **SUBSURFACE_ORACLES}
+
 LIGHT_WATTS = 1000.0
 LIGHT_DISTANCE = 2.0
 

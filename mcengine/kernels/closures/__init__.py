@@ -15,7 +15,9 @@ Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
 * ``bsdf_sample_closure``: picks closure k with probability sw_k / Σ sw_k, samples it
   and returns the throughput weight F / pdf of the whole list (for a singular
   lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes),
-  the lobe's label and k.
+  the lobe's label and k.  A BSSRDF (``bssrdf``) has no value: it only counts in Σ sw, and
+  when picked gives the direction into the object with weight w_k·Σ sw / sw_k and the
+  label LABEL_SUBSURFACE (the path tracer then walks inside).
 
 Every closure whose normal differs from the point's smooth normal (a normal map,
 Bump Map Correction's lift of a glossy normal) carries Cycles' bump shadowing
@@ -32,6 +34,7 @@ import math
 
 from ...jit import device, function
 from ..sampling import orthonormal_basis
+from .bssrdf import bssrdf_entry
 from .diffuse import (
     lambert_eval,
     lambert_sample,
@@ -44,11 +47,13 @@ from .layout import (
     CL_BUMP_CORRECTION,
     CL_N,
     CL_NS,
+    CL_SSS_METHOD,
     CL_SW,
     CL_T,
     CL_TERMINATOR,
     CL_TYPE,
     CL_W,
+    CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
@@ -63,8 +68,10 @@ from .layout import (
     LABEL_NONE,
     LABEL_REFLECT,
     LABEL_SINGULAR,
+    LABEL_SUBSURFACE,
     LABEL_TRANSMIT,
     LABEL_TRANSPARENT,
+    SSS_BURLEY,
 )
 from .microfacet import ggx_lambda_q, microfacet_eval, microfacet_sample
 from .sheen import sheen_eval, sheen_sample
@@ -201,6 +208,15 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
         x, y, z, r, g, b, pdf, label = microfacet_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_TRANSPARENT:
         return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
+    elif t == CT_BSSRDF:
+        x, y, z, ok = bssrdf_entry(cl, k, lox, loy, loz, u1, u2)
+        if not ok:
+            return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
+        # Christensen-Burley has no entry direction (so no side to check): its label is
+        # LABEL_SUBSURFACE alone.
+        label = LABEL_SUBSURFACE if cl[k, CL_SSS_METHOD] == SSS_BURLEY else LABEL_TRANSMIT | LABEL_SUBSURFACE
+        return (x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz,
+                1.0, 1.0, 1.0, 0.0, label)
     else:
         return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     wix, wiy, wiz = x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz
@@ -297,7 +313,8 @@ def bsdf_sample_closure(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
     wix, wiy, wiz, r, g, b, pdf, label = closure_sample(cl, pick, wox, woy, woz, u1, u2, u3)
     if label == LABEL_NONE:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, pick
-    if label & (LABEL_SINGULAR | LABEL_TRANSPARENT):
+    if label & (LABEL_SINGULAR | LABEL_TRANSPARENT | LABEL_SUBSURFACE):
+        # A BSSRDF's weight: Cycles' surface_shader_bssrdf_sample_weight.
         k = total / sw
         return (wix, wiy, wiz, cl[pick, CL_W] * r * k, cl[pick, CL_W + 1] * g * k,
                 cl[pick, CL_W + 2] * b * k, 0.0, label, pick)

@@ -53,6 +53,13 @@ CL_TERMINATOR = 43       # the object's Shadow Terminator Shading Offset as a fr
 CL_FILM_THICKNESS = 44   # microfacet: thin film over the surface, thickness in nm (<= 0.1: none)
 CL_FILM_IOR = 45         # microfacet: the film's IOR relative to the outside (tf / IOR on back faces)
 CL_STRIDE = 46
+# A BSSRDF row (CT_BSSRDF) keeps its walk's parameters in these columns; its microfacet
+# alpha (the refractive entry's roughness) in CL_AX and its IOR in CL_ETA.
+CL_RADIUS = CL_P0        # 3: mean free path per channel (after Cycles' scaling; 0: no walk)
+CL_SSS_ALBEDO = CL_F0    # 3: the surface albedo the walk reproduces
+CL_ANISOTROPY = CL_P3    # the phase function's g, in [0, 0.9]
+CL_SSS_METHOD = CL_P4    # SSS_* method
+CL_SSS_BUMP = 35         # 1: its normal comes from a linked Normal input (Cycles' SD_HAS_BSSRDF_BUMP)
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0
@@ -64,6 +71,12 @@ CT_MICROFACET = 5        # rough (or smooth) reflection only
 CT_MICROFACET_REFRACTION = 6   # rough (or smooth) refraction only
 CT_MICROFACET_GLASS = 7  # reflection and refraction, split by Fresnel
 CT_TRANSPARENT = 8       # straight pass-through (a transparent bounce)
+CT_BSSRDF = 9            # subsurface scattering: a random walk inside the object (``subsurface``)
+
+# -- subsurface methods (the nodes' subsurface_method / falloff) -------------------------------
+SSS_BURLEY = 0           # Christensen-Burley: disk probes of the surface around the point
+SSS_RANDOM_WALK = 1      # refractive GGX entry with the material's IOR and roughness
+SSS_RANDOM_WALK_SKIN = 2  # half diffuse entry, half refractive with roughness 1; dipole radius
 
 # -- Fresnel models --------------------------------------------------------------------------
 FR_NONE = 0              # reflectance 1 (the weight carries the colour), no TIR handling
@@ -84,6 +97,7 @@ LABEL_DIFFUSE = 4
 LABEL_GLOSSY = 8
 LABEL_SINGULAR = 16
 LABEL_TRANSPARENT = 32
+LABEL_SUBSURFACE = 256   # into the object, for a random walk (Cycles' LABEL_SUBSURFACE_SCATTER)
 
 # alpha_x * alpha_y at or below this is a singular (perfectly smooth) lobe: it can only be
 # sampled, never evaluated (Cycles' BSDF_ROUGHNESS_SQ_THRESH; roughness about 0.0038).

@@ -5,7 +5,7 @@ with the node's input registers and its mix weight; it appends the node's
 closures to the closure list and returns the node's emission, transparency
 and holdout.  The Principled BSDF follows Cycles' closure order and layering:
 alpha -> sheen -> coat (with its tint) -> emission -> metallic -> transmission
--> dielectric specular -> diffuse (or subsurface, rendered as diffuse).  The
+-> dielectric specular -> diffuse and subsurface (a BSSRDF closure).  The
 layers (sheen, coat, specular) pass weight x (1 - max(albedo / weight))
 downward, the albedo being the layer's directional albedo at the view
 direction; metallic and transmission mix instead.
@@ -20,10 +20,12 @@ import math
 
 from ...jit import device, function
 from ..closures import microfacet as mf
+from ..closures.bssrdf import BSSRDF_MIN_RADIUS, bssrdf_radius
 from ..closures.diffuse import oren_nayar_setup
 from ..closures.fresnel import F0_from_ior, ior_from_F0
 from ..closures.layout import (
     CL_ALBEDO,
+    CL_ANISOTROPY,
     CL_AX,
     CL_AY,
     CL_BUMP_CORRECTION,
@@ -38,7 +40,11 @@ from ..closures.layout import (
     CL_FRESNEL,
     CL_N,
     CL_NS,
+    CL_RADIUS,
     CL_RTINT,
+    CL_SSS_ALBEDO,
+    CL_SSS_BUMP,
+    CL_SSS_METHOD,
     CL_STRIDE,
     CL_SW,
     CL_T,
@@ -46,10 +52,12 @@ from ..closures.layout import (
     CL_TYPE,
     CL_W,
     CLOSURE_WEIGHT_CUTOFF,
+    CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
+    CT_NONE,
     CT_OREN_NAYAR,
     CT_SHEEN,
     CT_TRANSLUCENT,
@@ -58,10 +66,13 @@ from ..closures.layout import (
     MAX_CLOSURES,
     MD_BECKMANN,
     MD_GGX,
+    SSS_BURLEY,
+    SSS_RANDOM_WALK_SKIN,
 )
 from ..closures.sheen import sheen_setup
 from ..closures.thin_film import THIN_FILM_CUTOFF
 from ..sampling import orthonormal_basis
+from ..state import PF_DIFFUSE_ANCESTOR
 from .nodes import (
     COLOR_IN,
     D_NORMAL,
@@ -92,6 +103,7 @@ from .nodes import (
     K_PRINCIPLED,
     K_REFRACTION,
     K_SHEEN,
+    K_SUBSURFACE,
     K_TRANSLUCENT,
     K_TRANSPARENT,
     M_ANISOTROPY,
@@ -129,6 +141,11 @@ from .nodes import (
     P_SHEEN_WEIGHT,
     P_SPECULAR_LEVEL,
     P_SPECULAR_TINT,
+    P_SUBSURFACE_ANISOTROPY,
+    P_SUBSURFACE_IOR,
+    P_SUBSURFACE_METHOD,
+    P_SUBSURFACE_RADIUS,
+    P_SUBSURFACE_SCALE,
     P_SUBSURFACE_WEIGHT,
     P_TANGENT,
     P_THIN_FILM,
@@ -140,6 +157,13 @@ from .nodes import (
     R_ROUGHNESS,
     S_NORMAL,
     S_ROUGHNESS,
+    SS_ANISOTROPY,
+    SS_FALLOFF,
+    SS_IOR,
+    SS_NORMAL,
+    SS_RADIUS,
+    SS_ROUGHNESS,
+    SS_SCALE,
     TL_NORMAL,
 )
 
@@ -171,6 +195,12 @@ def alloc(cl, n, wr, wg, wb, sd):
     cl[n, CL_NS], cl[n, CL_NS + 1], cl[n, CL_NS + 2] = sd.nx, sd.ny, sd.nz
     cl[n, CL_BUMP_CORRECTION] = 1.0 if sd.bump_correction else 0.0
     return n, n + 1
+
+
+@device
+def normal_linked(regs, off):
+    """Whether a Normal input is linked (an unlinked one holds the zero vector)."""
+    return regs[off] != 0.0 or regs[off + 1] != 0.0 or regs[off + 2] != 0.0
 
 
 @device
@@ -364,6 +394,15 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         if k >= 0:
             nx, ny, nz = input_normal(regs, b + S_NORMAL, sd)
             sheen(cl, k, sd, nx, ny, nz, sat(regs[b + S_ROUGHNESS]))
+    elif kind == K_SUBSURFACE:
+        scale = regs[b + SS_SCALE]
+        nx, ny, nz = input_normal(regs, b + SS_NORMAL, sd)
+        nx, ny, nz = ensure_valid_reflection(sd, nx, ny, nz)
+        n = bssrdf(cl, n, sd, cr, cg, cb, regs[b + SS_RADIUS] * scale,
+                   regs[b + SS_RADIUS + 1] * scale, regs[b + SS_RADIUS + 2] * scale,
+                   regs[b + COLOR_IN], regs[b + COLOR_IN + 1], regs[b + COLOR_IN + 2],
+                   nx, ny, nz, normal_linked(regs, b + SS_NORMAL), sat(regs[b + SS_ROUGHNESS]),
+                   regs[b + SS_IOR], regs[b + SS_ANISOTROPY], regs[b + SS_FALLOFF])
     elif kind == K_GLOSSY:
         if sd.reflective_caustics:
             n = glossy(regs, b, cl, n, sd, cr, cg, cb)
@@ -383,6 +422,60 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
                 microfacet(cl, k, CT_MICROFACET_REFRACTION, regs[b + R_DISTRIBUTION], a, a,
                            1.0 / ior if sd.backfacing else ior, nx, ny, nz, 0.0, 0.0, 0.0, sd)
     return n, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@function
+def bssrdf(cl, n, sd, wr, wg, wb, rr, rg, rb, ar, ag, ab, nx, ny, nz, bump, alpha, ior,
+           anisotropy, method):
+    """Append a BSSRDF closure (Cycles' bssrdf_alloc and bssrdf_setup); returns the new count.
+
+    Channels whose radius is below BSSRDF_MIN_RADIUS go to a Lambert closure of their weight
+    instead (Cycles' own zero-radius limit), and so do all of a Christensen-Burley BSSRDF's
+    after a diffuse bounce; the BSSRDF's sample weight is |average weight| times its
+    remaining channels.  The IOR is clamped to [1.01, 3.8], the anisotropy to [0, 0.9];
+    Skin refracts with alpha 1.
+    """
+    k, n = alloc(cl, n, wr, wg, wb, sd)
+    if k < 0:
+        return n
+    ior = min(max(ior, 1.01), 3.8)
+    if method == SSS_RANDOM_WALK_SKIN:
+        alpha = 1.0
+    rr, rg, rb = max(rr, 0.0), max(rg, 0.0), max(rb, 0.0)
+    wr, wg, wb = cl[k, CL_W], cl[k, CL_W + 1], cl[k, CL_W + 2]
+    dr = dg = db = 0.0
+    channels = 3
+    if method == SSS_BURLEY and (sd.path_flags & PF_DIFFUSE_ANCESTOR):
+        rr = rg = rb = 0.0          # all three channels go to the Lambert closure below
+    if rr < BSSRDF_MIN_RADIUS:
+        dr, wr, rr, channels = wr, 0.0, 0.0, channels - 1
+    if rg < BSSRDF_MIN_RADIUS:
+        dg, wg, rg, channels = wg, 0.0, 0.0, channels - 1
+    if rb < BSSRDF_MIN_RADIUS:
+        db, wb, rb, channels = wb, 0.0, 0.0, channels - 1
+    if channels > 0:
+        cl[k, CL_TYPE] = CT_BSSRDF
+        cl[k, CL_W], cl[k, CL_W + 1], cl[k, CL_W + 2] = wr, wg, wb
+        cl[k, CL_SW] = abs((wr + wg + wb) / 3.0) * channels
+        set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
+        cl[k, CL_RADIUS] = bssrdf_radius(rr, ar, ior, method)
+        cl[k, CL_RADIUS + 1] = bssrdf_radius(rg, ag, ior, method)
+        cl[k, CL_RADIUS + 2] = bssrdf_radius(rb, ab, ior, method)
+        cl[k, CL_SSS_ALBEDO], cl[k, CL_SSS_ALBEDO + 1], cl[k, CL_SSS_ALBEDO + 2] = ar, ag, ab
+        cl[k, CL_AX] = cl[k, CL_AY] = alpha
+        cl[k, CL_ETA] = ior
+        cl[k, CL_ANISOTROPY] = min(max(anisotropy, 0.0), 0.9)
+        cl[k, CL_SSS_METHOD] = method
+        cl[k, CL_SSS_BUMP] = 1.0 if bump else 0.0
+    else:
+        cl[k, CL_TYPE] = CT_NONE
+        cl[k, CL_W] = cl[k, CL_W + 1] = cl[k, CL_W + 2] = cl[k, CL_SW] = 0.0
+    if channels < 3:
+        j, n = alloc(cl, n, dr, dg, db, sd)
+        if j >= 0:
+            cl[j, CL_TYPE] = CT_DIFFUSE
+            set_frame(cl, j, nx, ny, nz, 0.0, 0.0, 0.0)
+    return n
 
 
 @device
@@ -681,13 +774,17 @@ def principled(regs, b, mix_weight, cl, n, sd):
                     0.0, 0.0, 0.0, multiscatter)
             wr, wg, wb = layer_weight(cl, k, wr, wg, wb)
 
-    # Subsurface: Cycles' own zero-radius limit, a Lambert closure of the clamped colour.
+    # Subsurface: a BSSRDF of the clamped colour, radius Radius x Scale.
     if subsurface > CLOSURE_WEIGHT_CUTOFF:
-        k, n = alloc(cl, n, cbase_r * subsurface * wr, cbase_g * subsurface * wg,
-                     cbase_b * subsurface * wb, sd)
-        if k >= 0:
-            cl[k, CL_TYPE] = CT_DIFFUSE
-            set_frame(cl, k, rnx, rny, rnz, 0.0, 0.0, 0.0)
+        method = regs[b + P_SUBSURFACE_METHOD]
+        scale = regs[b + P_SUBSURFACE_SCALE]
+        o = b + P_SUBSURFACE_RADIUS
+        n = bssrdf(cl, n, sd, cbase_r * subsurface * wr, cbase_g * subsurface * wg,
+                   cbase_b * subsurface * wb, regs[o] * scale, regs[o + 1] * scale,
+                   regs[o + 2] * scale, cbase_r, cbase_g, cbase_b, rnx, rny, rnz,
+                   normal_linked(regs, b + P_NORMAL), roughness * roughness,
+                   regs[b + P_SUBSURFACE_IOR] if method == SSS_RANDOM_WALK_SKIN else eta,
+                   regs[b + P_SUBSURFACE_ANISOTROPY], method)
 
     # Diffuse, with the unclamped base colour.
     k, n = alloc(cl, n, base_r * (1.0 - subsurface) * wr, base_g * (1.0 - subsurface) * wg,

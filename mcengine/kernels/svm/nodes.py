@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from collections import namedtuple
 
+from ..closures.layout import SSS_BURLEY, SSS_RANDOM_WALK, SSS_RANDOM_WALK_SKIN
+
 FLOAT = "float"
 COLOR = "color"
 VECTOR = "vector"
@@ -187,8 +189,14 @@ FRESNEL_F82 = 0
 FRESNEL_PHYSICAL_CONDUCTOR = 1
 FRESNEL_TYPES = {"F82": FRESNEL_F82, "PHYSICAL_CONDUCTOR": FRESNEL_PHYSICAL_CONDUCTOR}
 
+# The Principled's subsurface_method and the Subsurface Scattering node's falloff.
+SSS_METHODS = {"BURLEY": SSS_BURLEY, "RANDOM_WALK": SSS_RANDOM_WALK,
+               "RANDOM_WALK_SKIN": SSS_RANDOM_WALK_SKIN}
+
 ENUMS = {
     "distribution": DISTRIBUTIONS,
+    "subsurface_method": SSS_METHODS,
+    "falloff": SSS_METHODS,
     "fresnel_type": FRESNEL_TYPES,
     "operation": OPERATIONS,
     "interpolation_type": MAP_RANGE_INTERPOLATIONS,
@@ -276,14 +284,15 @@ CLOSURES = {
         _c("Base Color", GREY), _f("Metallic", 0.0), _f("Roughness", 0.5), _f("IOR", 1.5),
         _f("Alpha", 1.0), _v("Normal"), _f("Diffuse Roughness", 0.0),
         _f("Subsurface Weight", 0.0), _v("Subsurface Radius", (1.0, 0.2, 0.1)),
-        _f("Subsurface Scale", 0.05), _f("Specular IOR Level", 0.5), _c("Specular Tint", WHITE),
+        _f("Subsurface Scale", 0.05), _f("Subsurface IOR", 1.4), _f("Subsurface Anisotropy", 0.0),
+        _f("Specular IOR Level", 0.5), _c("Specular Tint", WHITE),
         _f("Anisotropic", 0.0), _f("Anisotropic Rotation", 0.0), _v("Tangent", TANGENT),
         _f("Transmission Weight", 0.0), _f("Coat Weight", 0.0), _f("Coat Roughness", 0.03),
         _f("Coat IOR", 1.5), _c("Coat Tint", WHITE), _v("Coat Normal"),
         _f("Sheen Weight", 0.0), _f("Sheen Roughness", 0.5), _c("Sheen Tint", WHITE),
         _c("Emission Color", WHITE), _f("Emission Strength", 0.0),
         _f("Thin Film Thickness", 0.0), _f("Thin Film IOR", 1.33),
-        _p("distribution", DIST_MULTI_GGX)), _BSDF, False),
+        _p("distribution", DIST_MULTI_GGX), _p("subsurface_method", SSS_RANDOM_WALK)), _BSDF, False),
     "BsdfDiffuse": NodeSpec(2, (_c("Color", GREY), _f("Roughness", 0.0), _v("Normal")), _BSDF, False),
     "BsdfGlossy": NodeSpec(3, (_c("Color", GREY), _f("Roughness", 0.5), _f("Anisotropy", 0.0),
                                _f("Rotation", 0.0), _v("Normal"), _v("Tangent", TANGENT),
@@ -304,6 +313,10 @@ CLOSURES = {
                                   _v("Normal"), _v("Tangent", TANGENT), _f("Thin Film Thickness", 0.0),
                                   _f("Thin Film IOR", 1.33), _p("distribution", DIST_MULTI_GGX),
                                   _p("fresnel_type", FRESNEL_F82)), _BSDF, False),
+    "SubsurfaceScattering": NodeSpec(13, (_c("Color", GREY), _f("Scale", 0.05),
+                                          _v("Radius", (1.0, 0.2, 0.1)), _f("IOR", 1.4),
+                                          _f("Roughness", 1.0), _f("Anisotropy", 0.0), _v("Normal"),
+                                          _p("falloff", SSS_RANDOM_WALK)), _BSDF, False),
     "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
                          (Socket("Emission", SHADER, None),), False),
     "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
@@ -535,6 +548,11 @@ P_ALPHA = _P["Alpha"]
 P_NORMAL = _P["Normal"]
 P_DIFFUSE_ROUGHNESS = _P["Diffuse Roughness"]
 P_SUBSURFACE_WEIGHT = _P["Subsurface Weight"]
+P_SUBSURFACE_RADIUS = _P["Subsurface Radius"]
+P_SUBSURFACE_SCALE = _P["Subsurface Scale"]
+P_SUBSURFACE_IOR = _P["Subsurface IOR"]
+P_SUBSURFACE_ANISOTROPY = _P["Subsurface Anisotropy"]
+P_SUBSURFACE_METHOD = _P["prop:subsurface_method"]
 P_SPECULAR_LEVEL = _P["Specular IOR Level"]
 P_SPECULAR_TINT = _P["Specular Tint"]
 P_ANISOTROPIC = _P["Anisotropic"]
@@ -592,10 +610,19 @@ M_DISTRIBUTION = _M["prop:distribution"]
 M_FRESNEL = _M["prop:fresnel_type"]
 S_ROUGHNESS = OFFSETS["BsdfSheen"]["Roughness"]
 S_NORMAL = OFFSETS["BsdfSheen"]["Normal"]
+_SS = OFFSETS["SubsurfaceScattering"]
+SS_SCALE = _SS["Scale"]
+SS_RADIUS = _SS["Radius"]
+SS_IOR = _SS["IOR"]
+SS_ROUGHNESS = _SS["Roughness"]
+SS_ANISOTROPY = _SS["Anisotropy"]
+SS_NORMAL = _SS["Normal"]
+SS_FALLOFF = _SS["prop:falloff"]
 E_STRENGTH = OFFSETS["Emission"]["Strength"]
 assert OFFSETS["Background"]["Strength"] == E_STRENGTH
 
 K_PRINCIPLED = KIND["BsdfPrincipled"]
+K_SUBSURFACE = KIND["SubsurfaceScattering"]
 K_DIFFUSE = KIND["BsdfDiffuse"]
 K_GLOSSY = KIND["BsdfGlossy"]
 K_GLASS = KIND["BsdfGlass"]

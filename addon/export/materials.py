@@ -7,9 +7,6 @@ groups; every node the core evaluates, with its inputs and properties).  On
 top of that, materials translate a few shader nodes the core renders through
 others:
 
-* Subsurface Scattering becomes a Diffuse BSDF of its colour, and the
-  Principled's subsurface layer is rendered as diffuse (Cycles' own
-  zero-radius limit), warned;
 * any other shader node: 0.8 grey diffuse (Cycles' default surface), warned;
 * nothing linked to Surface, or no output: black, as in Cycles;
 * a material without a node tree uses ``diffuse_color``, as Cycles does.
@@ -137,12 +134,6 @@ class _MaterialGraph(GraphReader):
     pass_index = 0.0      # the material's pass index (Object Info's Material Index)
 
     def convert(self, node, groups) -> ShaderNode:
-        kind = node.bl_idname
-        if kind == "ShaderNodeSubsurfaceScattering":
-            self.note(f"{label(node)} (subsurface scattering)", "subsurface",
-                      f"{label(node)} rendered as diffuse of its colour")
-            return ShaderNode("BsdfDiffuse", {"Color": self._in(node, "Color", "color", groups)},
-                              name=node.name)
         copied = super().convert(node, groups)
         if copied.type == "ObjectInfo":
             copied.props["material_index"] = self.pass_index
@@ -153,21 +144,7 @@ class _MaterialGraph(GraphReader):
             self.note(f"{label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley",
                       "GGX used")
             copied.props["distribution"] = "GGX"
-        self._check(node, copied.type, copied.inputs)
         return copied
-
-    def _in(self, node, ident, kind, groups, default=None):
-        sockets = {s.identifier: s for s in node.inputs}
-        return self.input(node, sockets[ident], Socket(ident, kind, default), groups)
-
-    def _check(self, node, kind, inputs) -> None:
-        """Note what the closure model renders differently from Cycles."""
-        lbl = label(node)
-        sss = inputs.get("Subsurface Weight", 0.0)
-        if kind == "BsdfPrincipled" and (isinstance(sss, Link) or sss > 0.0):
-            self.note(f"{lbl} subsurface weight {fmt(sss) if not isinstance(sss, Link) else '(linked)'}",
-                      "subsurface",
-                      "subsurface rendered as diffuse of the base colour (Cycles' zero-radius limit)")
 
 
 def linked_node(socket):

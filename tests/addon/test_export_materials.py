@@ -196,15 +196,26 @@ def test_metallic_node_is_copied_with_its_fresnel_type(scene, fake_session, fres
     assert warnings == []
 
 
-def test_what_is_rendered_differently_is_warned_once(scene, fake_session):
-    mat = principled("Skin", Subsurface_Weight=0.5, Thin_Film_Thickness=300.0)
+def test_subsurface_is_exported_with_its_method_unwarned(scene, fake_session):
+    mat = principled("Skin", Subsurface_Weight=0.5, Subsurface_Anisotropy=0.25,
+                     Thin_Film_Thickness=300.0)
     out, warnings = exported(fake_session, mat)
-    assert len(warnings) == 1
-    for part in ("subsurface weight 0.5", "subsurface rendered as diffuse"):
-        assert part in warnings[0]
-    assert "thin film" not in warnings[0]         # rendered as Cycles does
+    assert warnings == []                       # random walk and thin film: as Cycles renders them
     node = surface(out)
+    assert node.inputs["Subsurface Weight"] == 0.5
+    assert node.inputs["Subsurface Anisotropy"] == 0.25
+    assert node.inputs["Subsurface IOR"] == pytest.approx(1.4)
+    assert node.props["subsurface_method"] == "RANDOM_WALK"
     assert node.inputs["Thin Film Thickness"] == 300.0 and node.inputs["Thin Film IOR"] == pytest.approx(1.33)
+
+    mat.node_tree.nodes["Principled BSDF"].subsurface_method = "BURLEY"
+    wax = principled("Wax")
+    replace_surface(wax, "ShaderNodeSubsurfaceScattering").falloff = "BURLEY"
+    for material, kind, prop in ((mat, "BsdfPrincipled", "subsurface_method"),
+                                 (wax, "SubsurfaceScattering", "falloff")):
+        out, warnings = exported(fake_session, material)
+        assert warnings == []
+        assert surface(out).type == kind and surface(out).props[prop] == "BURLEY"
 
 
 @pytest.mark.parametrize("bl_idname,anisotropy", [("ShaderNodeBsdfPrincipled", "Anisotropic"),

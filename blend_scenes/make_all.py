@@ -56,6 +56,7 @@ SCENES = (
     "holdout_objects",
     "world_sky",
     "material_displacement",
+    "material_subsurface",
 )
 
 

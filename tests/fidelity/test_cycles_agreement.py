@@ -47,7 +47,9 @@ def test_scenes_exist():
             # the tangents of anisotropic closures; thin-film interference
             "material_anisotropic", "material_thin_film",
             # holdout objects and collections; true displacement
-            "holdout_objects", "material_displacement"} <= names
+            "holdout_objects", "material_displacement",
+            # random-walk subsurface scattering
+            "material_subsurface"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

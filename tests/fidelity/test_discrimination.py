@@ -107,6 +107,24 @@ def test_ignored_thin_films_are_caught(renders):
     assert any(d["t"] > 0 for d in differing) and any(d["t"] < 0 for d in differing), differing
 
 
+def _subsurface_as_diffuse(scene):
+    """Every subsurface radius below Cycles' 1e-8 limit: the closures become Lambert."""
+    for material in bpy.data.materials:
+        for node in material.node_tree.nodes if material.node_tree else ():
+            for name in ("Subsurface Scale", "Scale"):
+                if name in node.inputs and node.type in ("BSDF_PRINCIPLED", "SUBSURFACE_SCATTERING"):
+                    node.inputs[name].default_value = 0.0
+
+
+def test_subsurface_rendered_as_diffuse_is_caught(renders):
+    """Subsurface as Lambert of its colour (Cycles' zero-radius limit, what MC Engine
+    rendered before it walked): no light through Suzanne's ears and the slab, harder
+    shading; blocks differ."""
+    result = renders.compare("material_subsurface", "subsurface as diffuse", _subsurface_as_diffuse)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 def _without_holdouts(scene):
     bpy.data.objects["Held"].is_holdout = False
     for layer in scene.view_layers:

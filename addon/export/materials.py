@@ -137,13 +137,6 @@ class _MaterialGraph(GraphReader):
         copied = super().convert(node, groups)
         if copied.type == "ObjectInfo":
             copied.props["material_index"] = self.pass_index
-        if copied.type == "BsdfSheen" and node.distribution == "ASHIKHMIN":
-            self.note(f"{label(node)} Ashikhmin velvet sheen", "velvet sheen",
-                      "microfibre sheen used")
-        if copied.props.get("distribution") == "ASHIKHMIN_SHIRLEY":
-            self.note(f"{label(node)} Ashikhmin-Shirley distribution", "ashikhmin-shirley",
-                      "GGX used")
-            copied.props["distribution"] = "GGX"
         return copied
 
 

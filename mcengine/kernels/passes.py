@@ -49,6 +49,7 @@ from .closures.layout import (
     CL_SW,
     CL_TYPE,
     CL_W,
+    CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
@@ -59,6 +60,7 @@ from .closures.layout import (
     CT_SHEEN,
     CT_TRANSLUCENT,
     CT_TRANSPARENT,
+    CT_VELVET,
     LABEL_REFLECT,
     ROUGHNESS_SQ_THRESHOLD,
 )
@@ -178,7 +180,8 @@ def roughness_squared(cl, k):
     t = cl[k, CL_TYPE]
     if t == CT_TRANSPARENT:
         return 0.0
-    if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+    if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS \
+            or t == CT_ASHIKHMIN_SHIRLEY:
         r2 = cl[k, CL_AX] * cl[k, CL_AY]
         return 0.0 if r2 <= ROUGHNESS_SQ_THRESHOLD else r2
     return 1.0
@@ -187,11 +190,11 @@ def roughness_squared(cl, k):
 @device
 def _pass_kind(cl, k, t, wix, wiy, wiz):
     """Which light pass closure k of type t scatters towards wi in: 0 diffuse (Cycles'
-    CLOSURE_IS_BSDF_DIFFUSE), 1 glossy (reflection, and glass on the side of its normal),
-    2 transmission."""
+    CLOSURE_IS_BSDF_DIFFUSE), 1 glossy (reflection, Ashikhmin-Shirley and velvet, and glass
+    on the side of its normal), 2 transmission."""
     if is_diffuse(t):
         return 0
-    if t == CT_MICROFACET or (t == CT_MICROFACET_GLASS and (
+    if t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET or (t == CT_MICROFACET_GLASS and (
             wix * cl[k, CL_N] + wiy * cl[k, CL_N + 1] + wiz * cl[k, CL_N + 2]) > 0.0):
         return 1
     return 2
@@ -469,7 +472,7 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
             t = cl[k, CL_TYPE]
             if is_diffuse(t) or t == CT_BSSRDF:    # Cycles' surface_shader_diffuse
                 o, refl, trans = c[P_DIFFUSE_COLOR], True, True
-            elif t == CT_MICROFACET:
+            elif t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET:
                 o, refl, trans = c[P_GLOSSY_COLOR], True, False
             elif t == CT_MICROFACET_REFRACTION:
                 o, refl, trans = c[P_TRANSMISSION_COLOR], False, True

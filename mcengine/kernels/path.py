@@ -49,6 +49,7 @@ from .closures.layout import (
     CL_TERMINATOR,
     CL_TYPE,
     CL_W,
+    CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
@@ -546,7 +547,8 @@ def blur_closures(cl, ncl, blur_pdf):
     r = math.sqrt(1.0 - blur_pdf) * 0.5
     for k in range(ncl):
         t = cl[k, CL_TYPE]
-        if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+        if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS \
+                or t == CT_ASHIKHMIN_SHIRLEY:
             cl[k, CL_AX] = max(cl[k, CL_AX], r)
             cl[k, CL_AY] = max(cl[k, CL_AY], r)
 

@@ -346,3 +346,13 @@ def test_a_tangent_normal_map_on_a_displaced_surface_is_warned(scene, fake_sessi
         assert bool(warnings) == warned, warnings
         if warned:
             assert "tangent-space Normal Map on a displaced surface" in warnings[0]
+
+
+@pytest.mark.parametrize("bl_idname,distribution", [("ShaderNodeBsdfAnisotropic", "ASHIKHMIN_SHIRLEY"),
+                                                    ("ShaderNodeBsdfSheen", "ASHIKHMIN")])
+def test_ashikhmin_distributions_are_exported_unwarned(scene, fake_session, bl_idname, distribution):
+    mat = principled("Ashikhmin")
+    replace_surface(mat, bl_idname).distribution = distribution
+    out, warnings = exported(fake_session, mat)
+    assert warnings == []
+    assert surface(out).props["distribution"] == distribution

@@ -5,8 +5,9 @@ closures in the array ``cl`` (layout and codes: ``layout``).  One module per
 family computes a closure's ``eval`` (f·|cos θ_i| and pdf) and ``sample`` in
 its local frame: ``diffuse`` (Lambert, Oren–Nayar, translucent),
 ``microfacet`` (GGX and Beckmann reflection, refraction and glass, with the
-Fresnel models of ``fresnel`` and the energy-compensation ``tables``) and
-``sheen``.  This module combines them as Cycles' surface_shader.h does:
+Fresnel models of ``fresnel`` and the energy-compensation ``tables``), ``sheen``,
+``ashikhmin`` (Ashikhmin-Shirley and the velvet) and ``bssrdf`` (subsurface scattering,
+which only picks the way in).  This module combines them as Cycles' surface_shader.h does:
 
 * ``bsdf_eval``: F = Σ w_k·eval_k over the closures whose pdf is not zero
   (closures whose label a light excludes add nothing to F but keep their pdf),
@@ -34,6 +35,7 @@ import math
 
 from ...jit import device, function
 from ..sampling import orthonormal_basis
+from .ashikhmin import ashikhmin_shirley_eval, ashikhmin_shirley_sample, velvet_eval, velvet_sample
 from .bssrdf import bssrdf_entry
 from .diffuse import (
     lambert_eval,
@@ -53,6 +55,7 @@ from .layout import (
     CL_TERMINATOR,
     CL_TYPE,
     CL_W,
+    CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
@@ -63,6 +66,7 @@ from .layout import (
     CT_SHEEN,
     CT_TRANSLUCENT,
     CT_TRANSPARENT,
+    CT_VELVET,
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
     LABEL_NONE,
@@ -178,6 +182,10 @@ def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
     lix, liy, liz = wix * tx + wiy * ty + wiz * tz, wix * bx + wiy * by + wiz * bz, wix * nx + wiy * ny + wiz * nz
     if t == CT_OREN_NAYAR:
         r, g, b, pdf = oren_nayar_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_ASHIKHMIN_SHIRLEY:
+        r, g, b, pdf = ashikhmin_shirley_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_VELVET:
+        r, g, b, pdf = velvet_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_SHEEN:
         r, g, b, pdf = sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
@@ -206,6 +214,10 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
         x, y, z, r, g, b, pdf, label = sheen_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
         x, y, z, r, g, b, pdf, label = microfacet_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_ASHIKHMIN_SHIRLEY:
+        x, y, z, r, g, b, pdf, label = ashikhmin_shirley_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_VELVET:
+        x, y, z, r, g, b, pdf, label = velvet_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_TRANSPARENT:
         return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
     elif t == CT_BSSRDF:
@@ -236,8 +248,8 @@ def excluded(t, exclude):
         return False
     if is_diffuse(t):
         return (exclude & LABEL_DIFFUSE) != 0
-    if t == CT_MICROFACET:
-        return (exclude & LABEL_GLOSSY) != 0
+    if t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET:
+        return (exclude & LABEL_GLOSSY) != 0    # velvet is glossy here, as in Cycles
     if t == CT_MICROFACET_REFRACTION:
         return (exclude & LABEL_TRANSMIT) != 0
     if t == CT_MICROFACET_GLASS:

@@ -60,6 +60,7 @@ CL_SSS_ALBEDO = CL_F0    # 3: the surface albedo the walk reproduces
 CL_ANISOTROPY = CL_P3    # the phase function's g, in [0, 0.9]
 CL_SSS_METHOD = CL_P4    # SSS_* method
 CL_SSS_BUMP = 35         # 1: its normal comes from a linked Normal input (Cycles' SD_HAS_BSSRDF_BUMP)
+CL_VELVET_INV_SIGMA2 = CL_P0   # a velvet's 1 / sigma^2 (sigma = max(roughness, 0.01))
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0
@@ -72,6 +73,8 @@ CT_MICROFACET_REFRACTION = 6   # rough (or smooth) refraction only
 CT_MICROFACET_GLASS = 7  # reflection and refraction, split by Fresnel
 CT_TRANSPARENT = 8       # straight pass-through (a transparent bounce)
 CT_BSSRDF = 9            # subsurface scattering: a random walk inside the object (``subsurface``)
+CT_ASHIKHMIN_SHIRLEY = 10  # the Glossy BSDF's Ashikhmin-Shirley lobe (``ashikhmin``)
+CT_VELVET = 11           # the Sheen BSDF's Ashikhmin velvet (``ashikhmin``)
 
 # -- subsurface methods (the nodes' subsurface_method / falloff) -------------------------------
 SSS_BURLEY = 0           # Christensen-Burley: disk probes of the surface around the point

@@ -20,6 +20,7 @@ import math
 
 from ...jit import device, function
 from ..closures import microfacet as mf
+from ..closures.ashikhmin import AS_MIN_ALPHA
 from ..closures.bssrdf import BSSRDF_MIN_RADIUS, bssrdf_radius
 from ..closures.diffuse import oren_nayar_setup
 from ..closures.fresnel import F0_from_ior, ior_from_F0
@@ -50,8 +51,10 @@ from ..closures.layout import (
     CL_T,
     CL_TTINT,
     CL_TYPE,
+    CL_VELVET_INV_SIGMA2,
     CL_W,
     CLOSURE_WEIGHT_CUTOFF,
+    CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
     CT_MICROFACET,
@@ -62,6 +65,7 @@ from ..closures.layout import (
     CT_SHEEN,
     CT_TRANSLUCENT,
     CT_TRANSPARENT,
+    CT_VELVET,
     FR_NONE,
     MAX_CLOSURES,
     MD_BECKMANN,
@@ -77,6 +81,8 @@ from .nodes import (
     COLOR_IN,
     D_NORMAL,
     D_ROUGHNESS,
+    DIST_ASHIKHMIN,
+    DIST_ASHIKHMIN_SHIRLEY,
     DIST_BECKMANN,
     DIST_MULTI_GGX,
     E_STRENGTH,
@@ -155,6 +161,7 @@ from .nodes import (
     R_IOR,
     R_NORMAL,
     R_ROUGHNESS,
+    S_DISTRIBUTION,
     S_NORMAL,
     S_ROUGHNESS,
     SS_ANISOTROPY,
@@ -393,7 +400,12 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         k, n = alloc(cl, n, cr, cg, cb, sd)
         if k >= 0:
             nx, ny, nz = input_normal(regs, b + S_NORMAL, sd)
-            sheen(cl, k, sd, nx, ny, nz, sat(regs[b + S_ROUGHNESS]))
+            if regs[b + S_DISTRIBUTION] == DIST_ASHIKHMIN:
+                cl[k, CL_TYPE] = CT_VELVET
+                set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
+                cl[k, CL_VELVET_INV_SIGMA2] = 1.0 / max(sat(regs[b + S_ROUGHNESS]), 0.01) ** 2
+            else:
+                sheen(cl, k, sd, nx, ny, nz, sat(regs[b + S_ROUGHNESS]))
     elif kind == K_SUBSURFACE:
         scale = regs[b + SS_SCALE]
         nx, ny, nz = input_normal(regs, b + SS_NORMAL, sd)
@@ -548,6 +560,12 @@ def glossy(regs, b, cl, n, sd, cr, cg, cb):
     else:
         tx = ty = tz = 0.0
     dist = regs[b + G_DISTRIBUTION]
+    if dist == DIST_ASHIKHMIN_SHIRLEY:
+        cl[k, CL_TYPE] = CT_ASHIKHMIN_SHIRLEY
+        set_frame(cl, k, nx, ny, nz, tx, ty, tz)
+        cl[k, CL_AX] = min(max(ax, AS_MIN_ALPHA), 1.0)
+        cl[k, CL_AY] = min(max(ay, AS_MIN_ALPHA), 1.0)
+        return n
     cos_no = microfacet(cl, k, CT_MICROFACET, dist, ax, ay, 1.0, nx, ny, nz, tx, ty, tz, sd)
     if dist == DIST_MULTI_GGX:
         microfacet_setup_fresnel_constant(cl, k, cos_no, max(regs[b + COLOR_IN], 0.0),

@@ -49,8 +49,11 @@ DIST_GGX = 0
 DIST_MULTI_GGX = 1
 DIST_BECKMANN = 2
 DIST_ASHIKHMIN_SHIRLEY = 3
+DIST_ASHIKHMIN = 4          # the Sheen BSDF's: Ashikhmin velvet
+DIST_MICROFIBER = 5         # and microfibre
 DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_BECKMANN,
-                 "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY}
+                 "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY, "ASHIKHMIN": DIST_ASHIKHMIN,
+                 "MICROFIBER": DIST_MICROFIBER}
 
 # Texture settings (codes are Cycles' enum values where it has them).
 DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
@@ -305,7 +308,8 @@ CLOSURES = {
                                    _v("Normal"), _p("distribution", DIST_BECKMANN)), _BSDF, False),
     "BsdfTranslucent": NodeSpec(6, (_c("Color", GREY), _v("Normal")), _BSDF, False),
     "BsdfTransparent": NodeSpec(7, (_c("Color", WHITE),), _BSDF, False),
-    "BsdfSheen": NodeSpec(8, (_c("Color", GREY), _f("Roughness", 0.5), _v("Normal")), _BSDF, False),
+    "BsdfSheen": NodeSpec(8, (_c("Color", GREY), _f("Roughness", 0.5), _v("Normal"),
+                              _p("distribution", DIST_MICROFIBER)), _BSDF, False),
     "BsdfMetallic": NodeSpec(12, (_c("Base Color", (0.617, 0.577, 0.540)),
                                   _c("Edge Tint", (0.695, 0.726, 0.770)),
                                   _v("IOR", (2.757, 2.513, 2.231)), _v("Extinction", (3.867, 3.404, 3.009)),
@@ -610,6 +614,7 @@ M_DISTRIBUTION = _M["prop:distribution"]
 M_FRESNEL = _M["prop:fresnel_type"]
 S_ROUGHNESS = OFFSETS["BsdfSheen"]["Roughness"]
 S_NORMAL = OFFSETS["BsdfSheen"]["Normal"]
+S_DISTRIBUTION = OFFSETS["BsdfSheen"]["prop:distribution"]
 _SS = OFFSETS["SubsurfaceScattering"]
 SS_SCALE = _SS["Scale"]
 SS_RADIUS = _SS["Radius"]

@@ -10,6 +10,12 @@ import math
 import numpy as np
 
 from mcengine.jit import kernel
+from mcengine.kernels.closures.ashikhmin import (
+    ashikhmin_shirley_eval,
+    ashikhmin_shirley_sample,
+    velvet_eval,
+    velvet_sample,
+)
 from mcengine.kernels.closures.diffuse import (
     lambert_eval,
     lambert_sample,
@@ -38,11 +44,14 @@ from mcengine.kernels.closures.layout import (
     CL_T,
     CL_TTINT,
     CL_TYPE,
+    CL_VELVET_INV_SIGMA2,
     CL_W,
+    CT_ASHIKHMIN_SHIRLEY,
     CT_DIFFUSE,
     CT_MICROFACET,
     CT_OREN_NAYAR,
     CT_TRANSLUCENT,
+    CT_VELVET,
     FR_NONE,
     MAX_CLOSURES,
     MD_GGX,
@@ -95,6 +104,19 @@ def microfacet_row(ctype: int = CT_MICROFACET, dist: int = MD_GGX, alpha: float 
     return cl
 
 
+def ashikhmin_shirley_row(alpha: float, alpha_y: float | None = None) -> np.ndarray:
+    cl = empty_row(CT_ASHIKHMIN_SHIRLEY)
+    cl[0, CL_AX] = alpha
+    cl[0, CL_AY] = alpha if alpha_y is None else alpha_y
+    return cl
+
+
+def velvet_row(roughness: float) -> np.ndarray:
+    cl = empty_row(CT_VELVET)
+    cl[0, CL_VELVET_INV_SIGMA2] = 1.0 / max(roughness, 0.01) ** 2
+    return cl
+
+
 def direction(theta_deg: float, phi_deg: float = 0.0) -> tuple[float, float, float]:
     t = math.radians(theta_deg)
     p = math.radians(phi_deg)
@@ -112,6 +134,10 @@ def sample_batch(cl, wox, woy, woz, u, out):
             res = translucent_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         elif t == CT_OREN_NAYAR:
             res = oren_nayar_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
+        elif t == CT_ASHIKHMIN_SHIRLEY:
+            res = ashikhmin_shirley_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
+        elif t == CT_VELVET:
+            res = velvet_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         else:
             res = microfacet_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         out[i, 0], out[i, 1], out[i, 2] = res[0], res[1], res[2]
@@ -130,6 +156,10 @@ def eval_batch(cl, wox, woy, woz, wi, out):
             res = translucent_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         elif t == CT_OREN_NAYAR:
             res = oren_nayar_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
+        elif t == CT_ASHIKHMIN_SHIRLEY:
+            res = ashikhmin_shirley_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
+        elif t == CT_VELVET:
+            res = velvet_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         else:
             res = microfacet_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = res

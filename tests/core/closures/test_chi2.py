@@ -1,10 +1,11 @@
 """Chi-square goodness of fit of every closure sampler against the pdf its eval returns.
 
-120 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
+132 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
 overall): Lambert, translucent and Oren-Nayar; GGX and Beckmann reflection, refraction and
 glass at eta 1.5 and 1/1.5; anisotropic GGX; GGX glass under a 400 nm thin film (coloured
 reflectance: the lobe is picked by its average); views at 0, 45 and 89 degrees; roughness
-0.05, 0.3 and 1 (alpha = roughness^2).  2^18 samples each, numpy Generator seeds fixed.
+0.05, 0.3 and 1 (alpha = roughness^2); Ashikhmin-Shirley (isotropic and anisotropic) and the
+Ashikhmin velvet.  2^18 samples each, numpy Generator seeds fixed.
 A representative subset runs by default, the whole grid with ``-m slow``.
 
 Two properties of Cycles' pdf that are not properties of its sampler are accounted for,
@@ -26,12 +27,14 @@ import pytest
 from scipy.special import erfc
 
 from mcengine.kernels.closures.layout import (
+    CT_ASHIKHMIN_SHIRLEY,
     CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_OREN_NAYAR,
     CT_TRANSLUCENT,
+    CT_VELVET,
     FR_DIELECTRIC,
     FR_NONE,
     FR_SCHLICK,
@@ -40,7 +43,14 @@ from mcengine.kernels.closures.layout import (
 )
 
 from . import chi2
-from .kernels import diffuse_row, direction, microfacet_row, oren_nayar_row
+from .kernels import (
+    ashikhmin_shirley_row,
+    diffuse_row,
+    direction,
+    microfacet_row,
+    oren_nayar_row,
+    velvet_row,
+)
 
 N_SAMPLES = 1 << 18
 THETAS = (0.0, 45.0, 89.0)
@@ -92,6 +102,15 @@ def _case_list():
             for phi in (0.0, 60.0):
                 cases.append((f"ggx-aniso-r{r}", dict(ctype=CT_MICROFACET, dist=MD_GGX, alpha=a * 0.5,
                                                       alpha_y=a / 0.5), theta, phi))
+    # Ashikhmin-Shirley (the Glossy node's): isotropic at roughness 0.3 and 1, anisotropic
+    # (anisotropy 0.5 at roughness 0.5, view azimuth 60); the Ashikhmin velvet at roughness 0.5
+    for theta in THETAS:
+        for r in (0.3, 1.0):
+            cases.append((f"ashikhmin-shirley-r{r}", dict(ctype=CT_ASHIKHMIN_SHIRLEY, alpha=r * r),
+                          theta, 0.0))
+        cases.append(("ashikhmin-shirley-aniso-r0.5", dict(ctype=CT_ASHIKHMIN_SHIRLEY, alpha=0.125,
+                                                            alpha_y=0.5), theta, 60.0))
+        cases.append(("velvet-r0.5", dict(ctype=CT_VELVET, sigma=0.5), theta, 0.0))
     # GGX glass under a thin film (the Glass node's Thin Film Thickness 400, IOR 1.33)
     for eta in (1.5, 1.0 / 1.5):
         for theta in THETAS:
@@ -115,6 +134,10 @@ def _row(params: dict, wo) -> np.ndarray:
         return diffuse_row(ctype)
     if ctype == CT_OREN_NAYAR:
         return oren_nayar_row(p["sigma"], (0.8, 0.8, 0.8), cos_no=wo[2])
+    if ctype == CT_ASHIKHMIN_SHIRLEY:
+        return ashikhmin_shirley_row(p["alpha"], p.get("alpha_y"))
+    if ctype == CT_VELVET:
+        return velvet_row(p["sigma"])
     return microfacet_row(ctype=ctype, **p)
 
 
@@ -138,6 +161,7 @@ def _params():
     out = []
     for i, (name, params, theta, phi) in enumerate(CASES):
         marks = () if (i in FAST or (name.endswith("r0.3") and theta == 45.0)
+                       or (name.startswith(("velvet", "ashikhmin")) and theta == 45.0)
                        or ("r0.3-eta" in name and theta == 45.0)) else (pytest.mark.slow,)
         out.append(pytest.param(params, theta, phi, id=f"{name}-th{theta:g}-ph{phi:g}", marks=marks))
     return out

@@ -41,7 +41,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device, function
-from .closures import closure_eval, excluded
+from .closures import closure_eval, excluded, is_diffuse
 from .closures.layout import (
     CL_AX,
     CL_AY,
@@ -51,14 +51,10 @@ from .closures.layout import (
     CL_W,
     CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
-    CT_DIFFUSE,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_NONE,
-    CT_OREN_NAYAR,
-    CT_SHEEN,
-    CT_TRANSLUCENT,
     CT_TRANSPARENT,
     CT_VELVET,
     LABEL_REFLECT,
@@ -155,12 +151,6 @@ def alloc_pass_buffers(n: int, n_shadow: int) -> PassBuffers:
 
 
 # -- closures ------------------------------------------------------------------------------------
-@device
-def is_diffuse(t):
-    """Cycles' CLOSURE_IS_BSDF_DIFFUSE: diffuse, Oren-Nayar, sheen and translucent."""
-    return t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT
-
-
 @function
 def closure_albedo(cl, k, wox, woy, woz, reflection, transmission):
     """Cycles' bsdf_albedo: the closure's weight, times the estimated albedo of a microfacet."""

@@ -395,39 +395,32 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, wkey, px, py, pz, ngx,
     oy = py + ny * h + ty * c + by * s
     oz = pz + nz * h + tz * c + bz * s
     dx, dy, dz = -nx, -ny, -nz
-    # Every surface of the object on the probe (0, 2h): the first four, then reservoir
-    # sampling keeps a uniform subset of four.
+    # Every surface of the object on the probe (0, 2h), nearest first: the first four, then
+    # reservoir sampling keeps a uniform subset of four.
     count = 0
     p0 = p1 = p2 = p3 = -1
     t0 = t1 = t2 = t3 = 0.0
-    k, end = lb.root[obj, 0], lb.root[obj, 1]
     tmax = 2.0 * h
-    while k < end:
-        if not ray_box(ox, oy, oz, dx, dy, dz, lb.box, k, tmax):
-            k = lb.node[k, 0]
-            continue
-        first = lb.node[k, 1]
-        for e in range(first, first + lb.node[k, 2]):
-            p = lb.tris[e]
-            a, b, cc = tris[p, 0], tris[p, 1], tris[p, 2]
-            t = hit_triangle(ox, oy, oz, dx, dy, dz, verts[a, 0], verts[a, 1], verts[a, 2],
-                             verts[b, 0], verts[b, 1], verts[b, 2], verts[cc, 0], verts[cc, 1],
-                             verts[cc, 2])
-            if not t < tmax:
-                continue
-            count += 1
-            slot = count - 1
-            if count > DISK_MAX_HITS:
-                slot = int(rand(wkey, 16 + count) * count)
-            if slot == 0:
-                p0, t0 = p, t
-            elif slot == 1:
-                p1, t1 = p, t
-            elif slot == 2:
-                p2, t2 = p, t
-            elif slot == 3:
-                p3, t3 = p, t
-        k += 1
+    t = 0.0
+    p = -1
+    while count < MAX_STEPS:
+        step, p = local_closest(lb, verts, tris, obj, ox + t * dx, oy + t * dy, oz + t * dz,
+                                dx, dy, dz, tmax - t, p)
+        if p < 0:
+            break
+        t += step
+        count += 1
+        slot = count - 1
+        if count > DISK_MAX_HITS:
+            slot = int(rand(wkey, 16 + count) * count)
+        if slot == 0:
+            p0, t0 = p, t
+        elif slot == 1:
+            p1, t1 = p, t
+        elif slot == 2:
+            p2, t2 = p, t
+        elif slot == 3:
+            p3, t3 = p, t
     if count == 0:
         return False, -1, px, py, pz, ngx, ngy, ngz, 0.0, 0.0, 0.0
     scale = count / DISK_MAX_HITS if count > DISK_MAX_HITS else 1.0

@@ -1,4 +1,5 @@
-"""Random-walk subsurface scattering, as Cycles walks (kernel/integrator/subsurface_random_walk.h).
+"""Subsurface scattering inside one object: random walks and Christensen-Burley disk probes,
+as Cycles does them (kernel/integrator/subsurface_random_walk.h, subsurface_disk.h).
 
 When a path picks a BSSRDF closure (``closures.bssrdf``) it refracts into the object and
 walks a homogeneous medium there until it leaves through the object's surface:

@@ -23,6 +23,7 @@ sys.path.insert(0, str(REPO))
 from tests.core.material_oracles import (  # noqa: E402
     ALL_ORACLES,
     LIGHT_WATTS,
+    SLAB_THICKNESS,
     SUBSURFACE_ORACLES,
     camera_matrix,
     light_position,
@@ -64,7 +65,13 @@ def build(bpy, name):
     scene.world = world
     mesh = bpy.data.meshes.new("plane")
     s = 50.0
-    mesh.from_pydata([(-s, -s, 0), (s, -s, 0), (s, s, 0), (-s, s, 0)], [], [(0, 1, 2, 3)])
+    if name in SLAB_THICKNESS:         # and a face below, facing down: a slab
+        d = -SLAB_THICKNESS[name]
+        mesh.from_pydata([(-s, -s, 0), (s, -s, 0), (s, s, 0), (-s, s, 0),
+                          (-s, -s, d), (s, -s, d), (s, s, d), (-s, s, d)], [],
+                         [(0, 1, 2, 3), (4, 7, 6, 5)])
+    else:
+        mesh.from_pydata([(-s, -s, 0), (s, -s, 0), (s, s, 0), (-s, s, 0)], [], [(0, 1, 2, 3)])
     ob = bpy.data.objects.new("plane", mesh)
     scene.collection.objects.link(ob)
     mat = bpy.data.materials.new(name)

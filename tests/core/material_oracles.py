@@ -122,8 +122,16 @@ SUBSURFACE_ORACLES = {
                                     {"subsurface_method": "BURLEY"})], 30.0, None),
     "subsurface_burley_point": ([("SubsurfaceScattering", {"Color": (0.9, 0.6, 0.3), "Scale": 0.2},
                                   {"falloff": "BURLEY"})], 30.0, (20.0, 180.0)),
+    # Light through a slab (the plane and a second one below it, facing down) from a point
+    # light under it: what the camera sees left the slab's top after entering at its bottom,
+    # so it depends on the radius against the thickness (a half-space does not).
+    "subsurface_slab": ([("BsdfPrincipled", {"Base Color": (0.8, 0.5, 0.3), "Subsurface Weight": 1.0,
+                                             "Subsurface Scale": 0.02}, {})], 20.0, (180.0, 0.0)),
+    "subsurface_burley_slab": ([("SubsurfaceScattering", {"Color": (0.8, 0.5, 0.3), "Scale": 0.02},
+                                 {"falloff": "BURLEY"})], 20.0, (180.0, 0.0)),
 }
 ALL_ORACLES = {**ORACLES, **SUBSURFACE_ORACLES}
+SLAB_THICKNESS = {"subsurface_slab": 0.005, "subsurface_burley_slab": 0.005}   # metres
 
 LIGHT_WATTS = 1000.0
 LIGHT_DISTANCE = 2.0

@@ -35,7 +35,14 @@ from mcengine.scene import (
 )
 
 from .expect import image_mean_and_se, render
-from .material_oracles import ALL_ORACLES, LIGHT_WATTS, ORACLES, camera_matrix, light_position
+from .material_oracles import (
+    ALL_ORACLES,
+    LIGHT_WATTS,
+    ORACLES,
+    SLAB_THICKNESS,
+    camera_matrix,
+    light_position,
+)
 
 MEASURED = json.loads((Path(__file__).with_name("material_oracles.json")).read_text())
 TOLERANCE = 2e-3
@@ -50,6 +57,8 @@ def oracle_scene(name, samples=16):
                                 dict(props)))
     s = 50.0
     plane = np.array([[[-s, -s, 0], [s, -s, 0], [s, s, 0]], [[-s, -s, 0], [s, s, 0], [-s, s, 0]]])
+    if name in SLAB_THICKNESS:          # and the same below, facing down: a slab
+        plane = np.concatenate([plane, plane[:, ::-1] - [0.0, 0.0, SLAB_THICKNESS[name]]])
     last = graph[-1].type
     material = Material(name=name, nodes=graph,
                         surface=Link(len(graph) - 1, "Shader" if last == "MixShader" else "BSDF"))

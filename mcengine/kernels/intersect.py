@@ -1,10 +1,11 @@
-"""Ray-scene intersection: the only module that talks to Embree (embreex).
+"""Ray-scene intersection: Embree's BVH (``kernels.embree``, the only module that calls
+Embree) merged with the moving objects, and the float64 geometry around the hits.
 
-embreex traces single rays in a C loop that releases the GIL, so two Python
-threads tracing two batches use both cores.  Its limits shape this module:
+Two Python worker threads trace their batches at once: the tracing kernels release the GIL.
+How the renderer lives with Embree's float32 rays:
 
-* rays are float32 and ``tnear`` is fixed at 0, and there are no filter
-  callbacks, so a ray leaving a surface must start slightly off it.
+* rays are float32, start at ``tnear`` 0 and have no filter callbacks, so a ray
+  leaving a surface must start slightly off it.
   :func:`offset_origin` moves the origin along the geometric normal by a
   distance proportional to the point's magnitude (float32 rounding of the
   origin and Embree's own arithmetic are relative errors, so a fixed epsilon
@@ -12,12 +13,12 @@ threads tracing two batches use both cores.  Its limits shape this module:
 * the closest-hit query returns only the primitive id; the integrator
   recomputes the hit distance and barycentrics in float64 from the triangle
   (:func:`intersect_triangle`), which is more accurate than Embree's float32
-  values and avoids the allocations of embreex's ``output=1`` mode;
+  values;
 * a ray that re-hits the triangle it starts on (possible only through
   rounding, as triangles are flat) is detected by primitive id and traced
   again from just past that hit (``Accel.closest`` callers do this).
 
-embreex has no motion blur (no time on rays, no motion BVH).  Objects that
+The Embree scene has no motion blur (no time on rays, no motion BVH).  Objects that
 move while the shutter is open (``kernels.motion``) are left out of the
 Embree scene and intersected exactly at each ray's time by the motion
 module's own BVHs; ``Accel`` merges the two, so the callers see one scene.
@@ -29,6 +30,7 @@ import math
 import numpy as np
 
 from ..jit import device, kernel
+from . import embree
 from .motion import moving_closest, moving_normals, moving_occluded, moving_triangle
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about
@@ -54,9 +56,11 @@ class Accel:
     triangles : (T, 3) int32
     motion : kernels.motion.MotionData, optional
         The moving objects; their triangles are intersected at each ray's time.
+    packets : bool
+        Trace in Embree's packets (``kernels.embree``); False: embreex's single rays.
     """
 
-    def __init__(self, vertices, triangles, motion=None):
+    def __init__(self, vertices, triangles, motion=None, packets=True):
         self.num_triangles = int(len(triangles))
         self._scene = None
         self._motion = motion if motion is not None and len(motion.tri_slot) else None
@@ -67,18 +71,7 @@ class Accel:
             self._tris = np.ascontiguousarray(triangles, np.int32)
             triangles = np.asarray(triangles)[self._static_ids]
         if len(triangles):
-            from embreex import rtcore_scene
-            from embreex.mesh_construction import TriangleMesh
-            # Robust mode: Embree's watertight triangle test.  The fast mode lets
-            # about one ray in ten aimed exactly at a shared edge or vertex
-            # slip between the triangles (tests/core/test_intersect.py), a
-            # light leak in closed rooms; robust costs ~25 % more per ray.
-            self._scene = rtcore_scene.EmbreeScene(robust=True)
-            TriangleMesh(self._scene, np.ascontiguousarray(vertices, np.float32),
-                         np.ascontiguousarray(triangles, np.int32))
-            # Commit now: embreex commits on the first query, which is not
-            # safe to do from two threads at once.
-            self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
+            self._scene = embree.build(vertices, triangles, packets)
 
     def closest(self, origins, directions, tfar, time=None):
         """Primitive id of the closest hit within (0, tfar), or -1.
@@ -90,7 +83,7 @@ class Accel:
         if self._scene is None or n == 0:
             prim = np.full(n, -1, np.int32)
         else:
-            prim = self._scene.run(origins, directions, dists=tfar, query="INTERSECT")
+            prim = self._scene.closest(origins, directions, tfar)
         if self._motion is None or n == 0:
             return prim
         if self._scene is not None:
@@ -107,7 +100,7 @@ class Accel:
         if self._scene is None or n == 0:
             blocked = np.zeros(n, np.bool_)
         else:
-            blocked = self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
+            blocked = self._scene.occluded(origins, directions, tfar)
         if self._motion is not None and n:
             moving_occluded(self._motion, self._verts, self._tris, origins, directions, tfar,
                             _times(time, n), blocked)

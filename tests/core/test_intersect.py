@@ -1,7 +1,13 @@
 """Embree closest hits against a brute-force float64 triangle test."""
 import numpy as np
+import pytest
 
+from mcengine.kernels import embree
 from mcengine.kernels.intersect import Accel, intersect_triangle
+
+# Both ways of calling Embree: packets through the library's C API (the default) and
+# embreex's single rays (the fallback where the library is not found).
+backends = pytest.mark.parametrize("packets", [True, False], ids=["packets", "embreex"])
 
 
 def brute_force(o, d, tris):
@@ -25,16 +31,18 @@ def brute_force(o, d, tris):
     return best, tbest
 
 
-def test_closest_hit_matches_brute_force():
+@backends
+def test_closest_hit_matches_brute_force(packets):
     rng = np.random.default_rng(7)
     centers = rng.uniform(-1, 1, (300, 1, 3))
     tris = centers + 0.3 * rng.standard_normal((300, 3, 3))
-    accel = Accel(tris.reshape(-1, 3).astype(np.float32), np.arange(900, dtype=np.int32).reshape(-1, 3))
+    accel = Accel(tris.reshape(-1, 3).astype(np.float32), np.arange(900, dtype=np.int32).reshape(-1, 3),
+                  packets=packets)
     tris32 = tris.astype(np.float32).astype(np.float64)
-    o = rng.uniform(-2, 2, (4000, 3))
-    d = rng.standard_normal((4000, 3))
+    o = rng.uniform(-2, 2, (3999, 3))
+    d = rng.standard_normal((3999, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    prim = accel.closest(o.astype(np.float32), d.astype(np.float32), np.full(4000, 1e30, np.float32))
+    prim = accel.closest(o.astype(np.float32), d.astype(np.float32), np.full(3999, 1e30, np.float32))
     ref, tref = brute_force(o, d, tris32)
     agree = prim == ref
     # Rays grazing an edge may go either way in float32; they must be rare and
@@ -47,9 +55,10 @@ def test_closest_hit_matches_brute_force():
     assert (ref >= 0).sum() > 300   # the test exercises hits, not just misses
 
 
-def test_tfar_limits_hits_and_occlusion():
+@backends
+def test_tfar_limits_hits_and_occlusion(packets):
     tri = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
-    accel = Accel(tri, np.array([[0, 1, 2]], np.int32))
+    accel = Accel(tri, np.array([[0, 1, 2]], np.int32), packets=packets)
     o = np.array([[0.2, 0.2, 1.0]] * 2, np.float32)
     d = np.array([[0, 0, -1.0]] * 2, np.float32)
     t = np.array([2.0, 0.5], np.float32)
@@ -57,8 +66,9 @@ def test_tfar_limits_hits_and_occlusion():
     assert accel.occluded(o, d, t.copy()).tolist() == [True, False]
 
 
-def test_empty_scene_misses():
-    accel = Accel(np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32))
+@backends
+def test_empty_scene_misses(packets):
+    accel = Accel(np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int32), packets=packets)
     o = np.zeros((3, 3), np.float32)
     assert accel.closest(o, o + 1, np.ones(3, np.float32)).tolist() == [-1, -1, -1]
     assert accel.occluded(o, o + 1, np.ones(3, np.float32)).tolist() == [False] * 3
@@ -70,7 +80,8 @@ def test_float64_refinement_is_exact_on_a_known_hit():
     assert (t, b1, b2) == (3.0, 0.25, 0.125)
 
 
-def test_rays_aimed_at_shared_edges_and_vertices_never_leak():
+@backends
+def test_rays_aimed_at_shared_edges_and_vertices_never_leak(packets):
     """Watertightness: from inside a closed mesh, rays aimed exactly at its shared
     edges and vertices must hit it (Embree's fast, non-robust mode lets about one
     in ten through here; the renderer uses the robust mode)."""
@@ -83,7 +94,7 @@ def test_rays_aimed_at_shared_edges_and_vertices_never_leak():
                         for t in idx for a, b in ((0, 1), (1, 2), (2, 0)) for f in (0.0, 0.25, 0.5)],
                        np.float32)
     rng = np.random.default_rng(0)
-    accel = Accel(verts, idx)
+    accel = Accel(verts, idx, packets=packets)
     for spread in (0.0, 0.1, 0.3):
         o = rng.standard_normal(targets.shape) * spread
         o *= np.minimum(1.0, 0.5 / np.maximum(np.linalg.norm(o, axis=1, keepdims=True), 1e-9))
@@ -92,3 +103,26 @@ def test_rays_aimed_at_shared_edges_and_vertices_never_leak():
         d = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
         prim = accel.closest(o, d, np.full(len(o), 1e30, np.float32))
         assert np.all(prim >= 0), f"{int((prim < 0).sum())} of {len(o)} rays leaked"
+
+
+def test_packets_are_the_default_and_agree_with_embreex_ray_for_ray():
+    """The wheel's library is found here, so renders trace in packets; and the packets give
+    embreex's answers exactly (the same library, the same robust mode), closest hits and
+    occlusion, for batches that do not fill the last packet."""
+    assert embree.library_path() is not None
+    rng = np.random.default_rng(3)
+    tris = (rng.uniform(-1, 1, (200, 1, 3)) + 0.4 * rng.standard_normal((200, 3, 3)))
+    verts, idx = tris.reshape(-1, 3).astype(np.float32), np.arange(600, dtype=np.int32).reshape(-1, 3)
+    fast, single = Accel(verts, idx), Accel(verts, idx, packets=False)
+    assert isinstance(fast._scene, embree._PacketScene)
+    n = 20001
+    o = rng.uniform(-2, 2, (n, 3)).astype(np.float32)
+    d = rng.standard_normal((n, 3))
+    d = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
+    t = rng.uniform(0.0, 3.0, n).astype(np.float32)
+    prim = fast.closest(o, d, t)
+    assert np.array_equal(prim, single.closest(o, d, t))
+    assert 0.2 < (prim >= 0).mean() < 0.9
+    blocked = fast.occluded(o, d, t)
+    assert np.array_equal(blocked, single.occluded(o, d, t))
+    assert np.array_equal(blocked, prim >= 0)

@@ -1,7 +1,7 @@
 """Where MC Engine's render time goes, per compiled function: a ``perf`` profile of the kernels.
 
 Renders blend_scenes/cornell_box.blend (the materials of ``bench_cornell.py``: the file's,
-the default Principled BSDF or textured) once to load the kernels, writes
+the default Principled BSDF or textured), or the .blend given with ``--scene``, once to load the kernels, writes
 ``/tmp/perf-<pid>.map`` naming every function numba compiled (the address of each
 overload's symbols in its code library; perf reads that file for code it finds no ELF file
 for), then records ``perf record`` samples of this process over a few renders and prints
@@ -17,8 +17,8 @@ it with ``objdump`` and prints the instructions with the most samples, each afte
 instructions before it, with the functions its calls go to named (numba compiles without
 debug information, so the listing is machine code, not source lines).
 
-Run: python benchmarks/profile_kernels.py [--materials file|principled|textured]
-                                          [--samples N] [--renders K] [--top T]
+Run: python benchmarks/profile_kernels.py [--scene FILE.blend] [--materials file|principled|textured]
+                                          [--samples N] [--resolution N] [--renders K] [--top T]
                                           [--annotate NAME [--context C]]
 """
 from __future__ import annotations
@@ -135,7 +135,11 @@ def short_name(symbol: str) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--materials", choices=("file", "principled", "textured"), default="principled")
+    ap.add_argument("--scene", type=Path, default=bench_cornell.SCENE,
+                    help="the .blend to render (default: the Cornell box)")
+    ap.add_argument("--materials", choices=("file", "principled", "textured"),
+                    help="the Cornell box's materials as bench_cornell.py sets them (default: "
+                         "principled for the Cornell box, the file's for any other scene)")
     ap.add_argument("--samples", type=int, default=128)
     ap.add_argument("--resolution", type=int, default=256)
     ap.add_argument("--renders", type=int, default=2)
@@ -145,6 +149,8 @@ def main(argv=None) -> int:
     ap.add_argument("--context", type=int, default=6,
                     help="instructions shown before each hot one (with --annotate)")
     args = ap.parse_args(argv)
+    if args.materials is None:
+        args.materials = "principled" if args.scene == bench_cornell.SCENE else "file"
     if shutil.which("perf") is None:
         print("profile_kernels: Linux 'perf' is not installed", file=sys.stderr)
         return 2
@@ -157,7 +163,7 @@ def main(argv=None) -> int:
     ensure_registered()
 
     def render(samples):
-        scene = open_scene(bench_cornell.SCENE)
+        scene = open_scene(args.scene)
         make_unbiased(scene)
         scene.mcengine.sampler = samplers.get(samplers.DEFAULT).enum_id
         if args.materials in ("principled", "textured"):
@@ -195,7 +201,7 @@ def main(argv=None) -> int:
             shares[short_name(symbol)] += share
         else:
             shares[dso] += share
-    print(f"cornell_box, {args.materials} materials, {args.resolution}x{args.resolution}, "
+    print(f"{args.scene.stem}, {args.materials} materials, {args.resolution}x{args.resolution}, "
           f"{args.samples} spp x {args.renders} renders ({seconds:.1f} s); {count} compiled "
           f"symbols named")
     print(f"{'share':>7s}  function (or shared library)")

@@ -25,12 +25,12 @@ from pathlib import Path
 
 import llvmlite.ir as ir
 import numpy as np
-from numba.core import types
+from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 from ..jit import kernel
 
-__all__ = ["PACKET", "build", "library_path"]
+__all__ = ["PACKET", "build", "build_local", "intersect_one", "library_path"]
 
 PACKET = 8                 # rays per Embree call (RTCRayHit8); 16 measured no faster here
 _ALIGN = 64                # bytes; Embree's packet structures are aligned to their width
@@ -76,6 +76,7 @@ class _Library:
             fn.restype, fn.argtypes = restype, argtypes
         self.lib = lib
         self.intersect = ctypes.cast(lib.rtcIntersect8, vp).value
+        self.intersect_one = ctypes.cast(lib.rtcIntersect1, vp).value
         self.occluded = ctypes.cast(lib.rtcOccluded8, vp).value
         self.device = lib.rtcNewDevice(None)
         if not self.device:
@@ -126,6 +127,23 @@ def build(vertices, triangles, packets: bool = True):
     if library is None:
         return _EmbreexScene(vertices, triangles)
     return _PacketScene(library, vertices, triangles)
+
+
+def build_local(vertices, triangles):
+    """A committed Embree scene of these triangles for single rays from compiled code
+    (:func:`intersect_one`), or None where the library is not found.
+
+    Returns ``(scene, handle, rtcIntersect1's address)``; the scene object owns the handle
+    (keep it alive while compiled code uses the handle); primitive ids are rows of
+    ``triangles``.  Only the vertices the triangles
+    use are copied.
+    """
+    library = _load()
+    if library is None:
+        return None
+    used, local = np.unique(np.asarray(triangles), return_inverse=True)
+    scene = _PacketScene(library, np.asarray(vertices)[used], local.reshape(-1, 3))
+    return scene, scene._scene, library.intersect_one
 
 
 class _PacketScene:
@@ -253,3 +271,44 @@ def trace_packets(fn, scene, o, d, tfar, out, occlusion, packet, packet_u, valid
             for k in range(m):
                 hit = packet_u[_GEOM_ID * w + k] != _INVALID_ID
                 out[s + k] = np.int32(packet_u[_PRIM_ID * w + k]) if hit else -1
+
+
+_RAY_HIT_WORDS = 24     # RTCRayHit: 12 words of ray, 8 of hit, spare for instPrimID, padding
+
+
+@intrinsic
+def intersect_one(typingctx, fn, scene, ox, oy, oz, dx, dy, dz, tnear, tfar):
+    """Closest hit of one ray (o, d) within [tnear, tfar] in a :func:`build_local` scene:
+    ``fn(scene, &rayhit, NULL)`` (fn: rtcIntersect1) with the RTCRayHit on the stack.
+    Returns (the hit's float32 distance as float64, its primitive id or -1)."""
+    sig = types.Tuple((types.float64, types.int64))(fn, scene, ox, oy, oz, dx, dy, dz, tnear, tfar)
+
+    def codegen(context, builder, signature, args):
+        i32, f32, i8p = ir.IntType(32), ir.FloatType(), ir.IntType(8).as_pointer()
+        slot = cgutils.alloca_once(builder, ir.ArrayType(i32, _RAY_HIT_WORDS))
+        slot.align = 16
+        words = builder.bitcast(slot, i32.as_pointer())
+        floats = builder.bitcast(slot, f32.as_pointer())
+
+        def at(pointer, k):
+            return builder.gep(pointer, [ir.Constant(i32, k)])
+        for k, value in ((_ORG, args[2]), (_ORG + 1, args[3]), (_ORG + 2, args[4]),
+                         (_DIR, args[5]), (_DIR + 1, args[6]), (_DIR + 2, args[7]),
+                         (_TNEAR, args[8]), (_TFAR, args[9])):
+            builder.store(builder.fptrunc(value, f32), at(floats, k))
+        builder.store(ir.Constant(f32, 0.0), at(floats, _TIME))
+        for k, value in ((_MASK, _INVALID_ID), (_ID, 0), (_FLAGS, 0),
+                         (_PRIM_ID, _INVALID_ID), (_GEOM_ID, _INVALID_ID)):
+            builder.store(ir.Constant(i32, value), at(words, k))
+        fnty = ir.FunctionType(ir.VoidType(), [i8p] * 3)
+        callee = builder.inttoptr(args[0], fnty.as_pointer())
+        builder.call(callee, [builder.inttoptr(args[1], i8p), builder.bitcast(slot, i8p),
+                              ir.Constant(i8p, None)])
+        geom = builder.load(at(words, _GEOM_ID))
+        hit = builder.icmp_unsigned("!=", geom, ir.Constant(i32, _INVALID_ID))
+        prim = builder.select(hit, builder.zext(builder.load(at(words, _PRIM_ID)), ir.IntType(64)),
+                              ir.Constant(ir.IntType(64), -1))
+        t = builder.fpext(builder.load(at(floats, _TFAR)), ir.DoubleType())
+        return context.make_tuple(builder, signature.return_type, [t, prim])
+    return sig, codegen
+

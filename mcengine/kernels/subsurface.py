@@ -13,8 +13,8 @@ walks a homogeneous medium there until it leaves through the object's surface:
   side the first step found); the step's weight is the balance heuristic over the
   {classic, guided, backward guided} x {r, g, b} strategies;
 * after 9 steps the phase function is made isotropic with the similarity relation;
-* the walk meets only the object's own triangles (a bounding-volume hierarchy per object
-  with subsurface materials, ``LocalBVH``); it gives up after 256 steps or when its
+* the walk meets only the object's own triangles (an Embree scene per object with
+  subsurface materials, ``LocalBVH``, traced one ray at a time from the walk); it gives up after 256 steps or when its
   throughput falls below 1e-6.
 
 A Christensen-Burley BSSRDF does not walk: ``disk_probe`` casts one probe ray through a
@@ -30,12 +30,15 @@ path key, the vertex and the step (Cycles scrambles its sequence there too).
 from __future__ import annotations
 
 import math
+import weakref
 from collections import namedtuple
 
 import numpy as np
 
 from ..jit import device
+from . import embree
 from .closures.bssrdf import disk_sample, disk_weight
+from .embree import intersect_one
 from .motion import BVH_LEAF, build_bvh, hit_triangle, ray_box
 from .sampling import orthonormal_basis, rand
 
@@ -51,26 +54,40 @@ LocalBVH = namedtuple("LocalBVH", [
     "root",      # (O, 2) int32  [first, end) node rows of object o's hierarchy (empty: none)
     "box",       # (K, 6) f64    node bounds (lo, hi)
     "node",      # (K, 3) int32  skip row, first leaf entry, leaf count (0: inner node)
-    "tris",      # (L,) int32    the leaves' triangles (scene ids)
+    "tris",      # (L,) int32    the leaves' triangles (scene ids); Embree: primitive ids
+    "embree",    # (O,) int64    object o's Embree scene (kernels.embree.build_local), 0: none
+    "first",     # (O,) int64    Embree: where object o's primitive ids start in ``tris``
+    "intersect", # (1,) int64    Embree: the address of rtcIntersect1 (0: hierarchies here)
 ])
 
 
 def no_local_bvh(objects: int = 0) -> LocalBVH:
     """A LocalBVH without hierarchies (no subsurface material in the scene)."""
     return LocalBVH(np.zeros((objects, 2), np.int32), np.zeros((0, 6)), np.zeros((0, 3), np.int32),
-                    np.zeros(0, np.int32))
+                    np.zeros(0, np.int32), np.zeros(objects, np.int64), np.zeros(objects, np.int64),
+                    np.zeros(1, np.int64))
 
 
-def build_local_bvh(verts, tris, tri_object, objects, wanted) -> LocalBVH:
+def build_local_bvh(verts, tris, tri_object, objects, wanted, embree_scenes=True) -> LocalBVH:
     """One hierarchy over each object in ``wanted`` (object indices), over its own triangles
-    as they are at the frame."""
+    as they are at the frame: an Embree scene each (as Cycles' walk uses Embree), or, with
+    ``embree_scenes=False`` or where the library is not found, compiled hierarchies here.
+
+    The Embree scenes are released when the returned ``embree`` array is garbage collected.
+    """
+    objects_ids = [(o, np.flatnonzero(tri_object == o).astype(np.int32))
+                   for o in sorted(set(int(w) for w in wanted))]
+    objects_ids = [(o, ids) for o, ids in objects_ids if len(ids)]
+    if not objects_ids:
+        return no_local_bvh(objects)
+    if embree_scenes:
+        local = _embree_local(verts, tris, objects, objects_ids)
+        if local is not None:
+            return local
     root = np.zeros((objects, 2), np.int32)
     boxes, nodes, leaves = [], [], []
     base_node = base_leaf = 0
-    for o in sorted(set(int(w) for w in wanted)):
-        ids = np.flatnonzero(tri_object == o).astype(np.int32)
-        if len(ids) == 0:
-            continue
+    for o, ids in objects_ids:
         corners = verts[tris[ids]]                       # (n, 3, 3)
         box, node, order = build_bvh(corners.min(axis=1), corners.max(axis=1), BVH_LEAF)
         node = node.astype(np.int64)
@@ -82,16 +99,36 @@ def build_local_bvh(verts, tris, tri_object, objects, wanted) -> LocalBVH:
         root[o] = base_node, base_node + len(box)
         base_node += len(box)
         base_leaf += len(ids)
-    if not boxes:
-        return no_local_bvh(objects)
-    return LocalBVH(root, np.ascontiguousarray(np.concatenate(boxes)),
-                    np.concatenate(nodes).astype(np.int32), np.concatenate(leaves).astype(np.int32))
+    empty = no_local_bvh(objects)
+    return empty._replace(root=root, box=np.ascontiguousarray(np.concatenate(boxes)),
+                          node=np.concatenate(nodes).astype(np.int32),
+                          tris=np.concatenate(leaves).astype(np.int32))
+
+
+def _embree_local(verts, tris, objects, objects_ids) -> LocalBVH | None:
+    handles = np.zeros(objects, np.int64)
+    first = np.zeros(objects, np.int64)
+    owners, address, start = [], 0, 0
+    for o, ids in objects_ids:
+        built = embree.build_local(verts, tris[ids])
+        if built is None:
+            return None
+        scene, handles[o], address = built
+        owners.append(scene)
+        first[o] = start
+        start += len(ids)
+    weakref.finalize(handles, owners.clear)     # the scenes live as long as their handles
+    return no_local_bvh(objects)._replace(
+        tris=np.concatenate([ids for _, ids in objects_ids]).astype(np.int32),
+        embree=handles, first=first, intersect=np.array([address], np.int64))
 
 
 @device
 def local_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip):
     """Closest hit within (0, tmax) on object ``obj``'s own triangles, ignoring triangle
-    ``skip``: (t, triangle), triangle -1 for none."""
+    ``skip`` (the one the ray starts on, or -1): (t, triangle), triangle -1 for none."""
+    if lb.intersect[0] != 0:
+        return _embree_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip)
     k, end = lb.root[obj, 0], lb.root[obj, 1]
     best, found = tmax, -1
     while k < end:
@@ -111,6 +148,31 @@ def local_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip):
                 best, found = t, p
         k += 1
     return best, found
+
+
+@device
+def _embree_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip):
+    """local_closest through the object's Embree scene (float32 rays from the float64 point);
+    the distance to the triangle found is recomputed in float64.  A hit on ``skip``, which
+    rounding can report near the ray's start, is traced again from just past it."""
+    scene = lb.embree[obj]
+    if scene == 0:
+        return tmax, -1
+    tnear = 0.0
+    for _ in range(3):
+        t32, q = intersect_one(lb.intersect[0], scene, ox, oy, oz, dx, dy, dz, tnear, tmax)
+        if q < 0:
+            return tmax, -1
+        p = lb.tris[lb.first[obj] + q]
+        if p != skip:
+            a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
+            t = hit_triangle(ox, oy, oz, dx, dy, dz, verts[a, 0], verts[a, 1], verts[a, 2],
+                             verts[b, 0], verts[b, 1], verts[b, 2], verts[c, 0], verts[c, 1],
+                             verts[c, 2])
+            # Embree's watertight float32 test may find a hit the float64 one misses at an edge.
+            return (t if t < math.inf else min(t32, tmax)), p
+        tnear = t32 * (1.0 + 2.0 ** -22) + 1e-30
+    return tmax, -1
 
 
 # -- the medium --------------------------------------------------------------------------

@@ -372,7 +372,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             if split and bounce == 0:
                 pb.pw[i, 0] = pb.pw[i, 1] = pb.pw[i, 2] = 1.0
                 pb.pw[i, 3] = pb.pw[i, 4] = pb.pw[i, 5] = 0.0
-            if _walk(sc, st, i, scratch.cl, ds.pick, p, sp, ds.wix, ds.wiy, ds.wiz, vertex):
+            if _walk(sc, st, i, scratch.cl, ds.pick, p, sp, ds.wix, ds.wiy, ds.wiz, vertex,
+                     sampler, mask):
                 st.alive[i] = 1
             continue
         if ds.label & LABEL_TRANSPARENT:
@@ -405,7 +406,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
 
 
 @function
-def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex):
+def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex, sampler, mask):
     """Take path i from ``sp`` on triangle p to where BSSRDF closure k lets the light out of
     the object: a random walk along wi, or Christensen-Burley's disk probe; returns whether
     it found an exit.  Then its ray comes from outside to the exit triangle (the next
@@ -417,8 +418,8 @@ def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex):
     wkey = walk_key(st.key[i], vertex)
     if cl[k, CL_SSS_METHOD] == SSS_BURLEY:
         left, q, ex, ey, ez, gx, gy, gz, wr, wg, wb = disk_probe(
-            sc.local, sc.verts, sc.tris, sc.normals, sc.tri_normal, obj, wkey, sp.hx, sp.hy,
-            sp.hz, sp.ngx, sp.ngy, sp.ngz, sp.backfacing, cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
+            sc.local, sc.verts, sc.tris, sc.normals, sc.tri_normal, obj, sampler, wkey, mask,
+            sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz, sp.backfacing, cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
             cl[k, CL_RADIUS + 2])
         if not left:
             return False
@@ -426,7 +427,7 @@ def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex):
         ddx, ddy, ddz, t = gx, gy, gz, 0.5     # the exit faces its normal
     else:
         left, q, ex, ey, ez, ddx, ddy, ddz, t, tr, tg, tb = random_walk(
-            sc.local, sc.verts, sc.tris, obj, wkey, sp.hx, sp.hy, sp.hz, wix, wiy, wiz,
+            sc.local, sc.verts, sc.tris, obj, sampler, wkey, mask, sp.hx, sp.hy, sp.hz, wix, wiy, wiz,
             sp.nsx, sp.nsy, sp.nsz, p, cl[k, CL_SSS_ALBEDO], cl[k, CL_SSS_ALBEDO + 1],
             cl[k, CL_SSS_ALBEDO + 2], cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
             cl[k, CL_RADIUS + 2], cl[k, CL_ANISOTROPY], st.beta[i, 0], st.beta[i, 1],

@@ -62,6 +62,7 @@ _INV_2_53 = 1.0 / 9007199254740992.0
 _K_SEED_B = np.uint64(0x5851F42D4C957F2D)   # any odd 64-bit constants
 _K_SEED_C = np.uint64(0x14057B7EF767814F)
 _K_WALK = np.uint64(0x2545F4914F6CDD1D)
+_K_WALK_SETS = np.uint64(0x9FB21C651E98DF25)
 
 
 @device
@@ -89,8 +90,12 @@ def rand(key, dim):
 
 @device
 def walk_key(key, vertex):
-    """Key of the independent numbers of a subsurface walk from path vertex ``vertex``."""
-    return mix64(key ^ (np.uint64(vertex + 1) * _K_WALK))
+    """Key of the numbers of a subsurface walk from path vertex ``vertex`` (its dimension sets
+    start again at 0): other scrambles (the key's high bits) than the path's and than the
+    exit's, the same sample index (low bits), so the Sobol sampler stays stratified over the
+    pixel's samples at every step of the walk."""
+    h = mix64((key >> np.uint64(SAMPLE_BITS)) ^ (np.uint64(vertex + 1) * _K_WALK_SETS))
+    return key ^ (h << np.uint64(SAMPLE_BITS))
 
 
 @device

@@ -24,8 +24,9 @@ the closure's diffusion profile), keeps up to four of the object's surfaces it c
 three axes, and resamples one of them as the exit (Cycles' subsurface_disk.h).
 
 The path then continues from the exit point with a Lambert closure of weight 1 (the path
-tracer does that, ``path.shade``).  The walk's random numbers are independent hashes of the
-path key, the vertex and the step (Cycles scrambles its sequence there too).
+tracer does that, ``path.shade``).  The walk's numbers come from the path's sampler with a
+key of the walk's own (``sampling.walk_key``: with Sobol, stratified over the pixel's samples
+at every step), as Cycles scrambles its sequence's dimensions for the walk.
 """
 from __future__ import annotations
 
@@ -40,7 +41,7 @@ from . import embree
 from .closures.bssrdf import disk_sample, disk_weight
 from .embree import intersect_one
 from .motion import BVH_LEAF, build_bvh, hit_triangle, ray_box
-from .sampling import orthonormal_basis, rand
+from .sampling import orthonormal_basis, rand, sample_2d, sample_4d
 
 MAX_STEPS = 256                  # Cycles' BSSRDF_MAX_BOUNCES
 SIMILARITY_LEVEL = 9             # steps with the real phase function (Cycles' similarity level)
@@ -254,11 +255,14 @@ def _step_pdf(sigma, t, hit):
 
 # -- the walk ------------------------------------------------------------------------------------
 @device
-def random_walk(lb, verts, tris, obj, wkey, px, py, pz, dx, dy, dz, nx, ny, nz, entry,
-                ar, ag, ab, rr, rg, rb, g, tr, tg, tb):
+def random_walk(lb, verts, tris, obj, sampler, wkey, mask, px, py, pz, dx, dy, dz, nx, ny, nz,
+                entry, ar, ag, ab, rr, rg, rb, g, tr, tg, tb):
     """Walk from the entry point p (on triangle ``entry`` of object ``obj``, smooth normal n
     facing out) along the entry direction d, with the closure's albedo a, radius r and
-    anisotropy g, starting with the path throughput t (closure weight included).
+    anisotropy g, starting with the path throughput t (closure weight included).  Step k
+    draws its numbers from the walk key's dimension sets 2k (colour channel, distance, the
+    guided and the backward choices) and 2k + 1 (direction), as Cycles draws each step's
+    from its sampler.
 
     Returns (left, exit triangle, exit point, last direction, last step length, throughput
     r, g, b).
@@ -304,7 +308,7 @@ def random_walk(lb, verts, tris, obj, wkey, px, py, pz, dx, dy, dz, nx, ny, nz, 
             gs, guided_fraction = 0.0, 0.75
             s_r, s_g, s_b = star_r, star_g, star_b
             c_r, c_g, c_b = sr * alr * (1.0 - g), sg * alg * (1.0 - g), sb * alb * (1.0 - g)
-        base = 8 * step
+        u, u_t, u_guided, u_backward = sample_4d(sampler, wkey, 2 * step, mask)
         # Colour channel, in proportion to throughput x albedo.
         wr, wg, wb = abs(tr * alr), abs(tg * alg), abs(tb * alb)
         total = wr + wg + wb
@@ -312,26 +316,24 @@ def random_walk(lb, verts, tris, obj, wkey, px, py, pz, dx, dy, dz, nx, ny, nz, 
             pr, pg, pb = wr / total, wg / total, wb / total
         else:
             pr = pg = pb = 1.0 / 3.0
-        u = rand(wkey, base)
         if u < pr:
             sigma = s_r
         elif u < pr + pg:
             sigma = s_g
         else:
             sigma = s_b
-        u_t = rand(wkey, base + 1)
 
         backward_fraction = 0.0
         forward_factor = backward_factor = 0.0
         forward_stretch = backward_stretch = 1.0
         if step > 0:
-            guided = rand(wkey, base + 2) < guided_fraction
+            guided = u_guided < guided_fraction
             backward = False
             if have_opposite:
                 x = min(max(-((px - ox) * nx + (py - oy) * ny + (pz - oz) * nz), 0.0), opposite)
                 backward_fraction = 1.0 / (1.0 + math.exp((opposite - 2.0 * x) / dl))
-                backward = rand(wkey, base + 3) < backward_fraction
-            u1, u2 = rand(wkey, base + 4), rand(wkey, base + 5)
+                backward = u_backward < backward_fraction
+            u1, u2 = sample_2d(sampler, wkey, 2 * step + 1, mask)
             if guided:
                 cos_theta = dl - (dl + 1.0) * math.exp(-u1 * phase_log)
                 if backward:
@@ -430,15 +432,16 @@ def hit_normal(normals, tri_normal, p, flip):
 
 
 @device
-def disk_probe(lb, verts, tris, normals, tri_normal, obj, wkey, px, py, pz, ngx, ngy, ngz,
-               backfacing, rr, rg, rb):
+def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, px, py, pz,
+               ngx, ngy, ngz, backfacing, rr, rg, rb):
     """Christensen-Burley's exit from point p (geometric normal ng on the viewer's side) of
     object ``obj``, radius r per channel.
 
     Returns (found, exit triangle, exit point, its normal (the exit faces it), weight r, g,
-    b): the factor on the path throughput.
+    b): the factor on the path throughput.  The disk point and the resampling take the walk
+    key's dimension set 0; the reservoir's choices beyond four surfaces are hashes.
     """
-    u1, u2 = rand(wkey, 0), rand(wkey, 1)
+    u1, u2, u_resample, _ = sample_4d(sampler, wkey, 0, mask)
     tx, ty, tz, bx, by, bz = orthonormal_basis(ngx, ngy, ngz)
     nx, ny, nz = ngx, ngy, ngz
     if u2 < 0.5:
@@ -514,7 +517,7 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, wkey, px, py, pz, ngx,
     total = s0 + s1 + s2 + s3
     if not total > 0.0:
         return False, -1, px, py, pz, ngx, ngy, ngz, 0.0, 0.0, 0.0
-    u = rand(wkey, 2) * total
+    u = u_resample * total
     if u < s0 or (s1 == 0.0 and s2 == 0.0 and s3 == 0.0):
         p, t, sw, wr, wg, wb = p0, t0, s0, wr0, wg0, wb0
     elif u < s0 + s1 or (s2 == 0.0 and s3 == 0.0):

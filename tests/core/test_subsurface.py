@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numba
 import numpy as np
 import pytest
 
@@ -29,7 +30,15 @@ from mcengine.kernels.closures.bssrdf import (
     dipole_alpha_prime,
     disk_sample,
 )
-from mcengine.kernels.sampling import SAMPLE_BITS, exit_key, walk_key
+from mcengine.kernels.sampling import (
+    SAMPLE_BITS,
+    SAMPLER_SOBOL,
+    exit_key,
+    sample_4d,
+    sample_key,
+    walk_key,
+)
+from mcengine.kernels.sobol import index_mask
 from mcengine.kernels.subsurface import build_local_bvh, hg_phase, hg_sample, local_closest, remap
 from mcengine.passes import RenderPasses
 from mcengine.scene import Geometry
@@ -39,6 +48,7 @@ from .expect import Z_LIMIT, render
 from .material_oracles import SUBSURFACE_ORACLES
 from .scenes import uv_sphere
 from .test_material_oracles import MEASURED, oracle_scene
+from .test_sobol import _is_net
 
 RELATIVE = 2e-3
 
@@ -185,8 +195,31 @@ def test_exit_key_changes_the_scrambles_and_keeps_the_sample_index():
     for vertex in range(4):
         k2 = int(exit_key(np.uint64(key), vertex))
         assert k2 & low == key & low and k2 != key
-        assert int(walk_key(np.uint64(key), vertex)) != k2
+        k3 = int(walk_key(np.uint64(key), vertex))
+        assert k3 & low == key & low and k3 not in (key, k2)
     assert len({int(exit_key(np.uint64(key), v)) for v in range(16)}) == 16
+    assert len({int(walk_key(np.uint64(key), v)) for v in range(16)}) == 16
+
+
+@numba.njit
+def _walk_numbers(seed, pixel, n, vertex, dim_set, mask):
+    out = np.zeros((n, 4))
+    for s in range(n):
+        wkey = walk_key(sample_key(SAMPLER_SOBOL, seed, pixel, s), vertex)
+        out[s, 0], out[s, 1], out[s, 2], out[s, 3] = sample_4d(SAMPLER_SOBOL, wkey, dim_set,
+                                                                np.uint64(mask))
+    return out
+
+
+@pytest.mark.parametrize("vertex,dim_set", [(0, 0), (2, 1), (1, 2 * 9), (5, 2 * 200 + 1)])
+def test_walk_numbers_are_stratified_over_a_pixels_samples(vertex, dim_set):
+    """With Sobol, every step's numbers of a walk (its key's dimension sets) over a pixel's
+    64 samples put one point in each elementary interval of area 1/64, as the path's own
+    numbers do: a walk key that hashed the sample index away would not."""
+    points = _walk_numbers(3, 4242, 64, vertex, dim_set, index_mask(64))
+    assert _is_net(points[:, :2], 6, 0)
+    for d in range(4):
+        assert np.array_equal(np.sort(np.floor(points[:, d] * 64)), np.arange(64))
 
 
 @pytest.mark.parametrize("inputs", [

@@ -35,8 +35,9 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 CORNELL_BOX = REPO / "blend_scenes" / "cornell_box.blend"
 BUNDLED = ["mcengine", "numba", "llvmlite", "embreex", "OpenEXR", "pyoidn", "cffi"]
-# The render denoises (Cycles' denoising settings), so Open Image Denoise loads too.
-USED_BY_EVERY_RENDER = {"mcengine", "numba", "embreex", "pyoidn"}
+# The render denoises (Cycles' denoising settings), so Open Image Denoise loads too.  embreex
+# is not imported: the renderer loads the Embree library its wheel ships (checked below).
+USED_BY_EVERY_RENDER = {"mcengine", "numba", "pyoidn"}
 RESOLUTION = 32
 SAMPLES = 4
 
@@ -70,6 +71,9 @@ CHILD = textwrap.dedent("""
     bpy.ops.render.render(write_still=True)
     report["used_by_render"] = [m for m in bundled if m in sys.modules]
     report["modules"] = {m: importlib.import_module(m).__file__ for m in bundled}
+    from mcengine.kernels import embree
+    report["embree_packets"] = embree._library is not None
+    report["embree_library"] = embree.library_path()
     print("REPORT " + json.dumps(report))
 """)
 
@@ -148,6 +152,9 @@ def test_extension_installs_and_renders_with_its_own_wheels(tmp_path):
     assert USED_BY_EVERY_RENDER <= set(report["used_by_render"]), report["used_by_render"]
     for module, file in report["modules"].items():
         assert Path(file).is_relative_to(wheels_site), f"{module} imported from {file}"
+    # The render traced in packets through the Embree library of the extension's embreex wheel.
+    assert report["embree_packets"]
+    assert Path(report["embree_library"]).is_relative_to(wheels_site / "embreex.libs")
 
     import OpenEXR
     with OpenEXR.File(str(out)) as exr:

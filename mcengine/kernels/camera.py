@@ -401,6 +401,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | (PF_FIRST_SAMPLE if sample == 0 else 0)
             st.mis_pdf[n] = 0.0
             st.mis_p[n, 0], st.mis_p[n, 1], st.mis_p[n, 2] = ox, oy, oz   # ray length from here
+            st.mis_p[n, 3] = st.mis_p[n, 4] = st.mis_p[n, 5] = 0.0
             st.min_pdf[n] = math.inf
             st.self_prim[n] = -1
             st.dp[n], st.dd[n] = camera_differential(sc.camera, x + fx, y + fy)

@@ -112,6 +112,7 @@ def _push_child(nx, n_next, st, i, key, sp, wix, wiy, wiz, br, bg, bb, flags, mi
     nx.flags[n_next] = flags
     nx.mis_pdf[n_next] = mis_pdf
     nx.mis_p[n_next, 0], nx.mis_p[n_next, 1], nx.mis_p[n_next, 2] = sp.hx, sp.hy, sp.hz
+    nx.mis_p[n_next, 3] = nx.mis_p[n_next, 4] = nx.mis_p[n_next, 5] = 0.0   # every light: no pick
     nx.self_prim[n_next] = p
     ox, oy, oz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz, wix, wiy, wiz)
     set_ray(nx.ray_o, nx.ray_d, nx.ray_tmax, nx.o32, nx.d32, nx.t32, n_next,
@@ -132,7 +133,7 @@ def _copy_node(nx, n_next, st, i, advance):
     nx.transparent[n_next] = st.transparent[i]
     nx.flags[n_next] = st.flags[i]
     nx.mis_pdf[n_next] = st.mis_pdf[i]
-    for c in range(3):
+    for c in range(6):
         nx.mis_p[n_next, c] = st.mis_p[i, c]
     nx.self_prim[n_next] = st.self_prim[i]
     nx.dp[n_next] = st.dp[i] + st.dd[i] * advance
@@ -168,7 +169,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         root = st.root[i]
         flags = st.flags[i]
         mis_pdf = st.mis_pdf[i]
-        mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
+        mp = (st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2], 0.0, 0.0, 0.0)
         bounce = st.bounce[i]
         br, bg, bb = st.beta[i, 0], st.beta[i, 1], st.beta[i, 2]
         t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i], st.time[i])
@@ -177,7 +178,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if lamps_hit:
             passed = light_from_lamps(sc, cfg, fcfg, stats, acc, root, st.beta, i,
                                       ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, PMF_EVERY,
-                                      mpx, mpy, mpz, 0.0, st.transparent[i], direct)
+                                      mp, 0.0, st.transparent[i], direct)
             if passed:
                 st.transparent[i] += passed
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
@@ -185,7 +186,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if p < 0:
             acc[root, 3] += light_from_background(sc, cfg, fcfg, scratch, stats, acc, root, st.beta, i,
                                                   dx, dy, dz, flags, mis_pdf, PMF_EVERY,
-                                                  mpx, mpy, mpz, 0.0, direct)
+                                                  mp, 0.0, direct)
             continue
         if sc.tri_area[p] <= 0.0:
             continue
@@ -201,7 +202,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                           depths, footprint)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp,
-                               flags, mis_pdf, PMF_EVERY, mpx, mpy, mpz, 0.0, direct,
+                               flags, mis_pdf, PMF_EVERY, mp, 0.0, direct,
                                res.er, res.eg, res.eb)
         if terminate or res.n == 0:
             continue

@@ -8,13 +8,15 @@ at a shading point picks one light (path tracing) or visits every light
   triangles" in proportion to an estimate of their power;
 * ``PMF_LOCAL``: in proportion to each light's estimated irradiance at the
   point (``lamp_importance``), the emissive triangles counting as one light
-  (then one triangle by power);
+  (then one triangle by power), times Cycles' light-tree facing term: lights
+  wholly behind an opaque surface are not picked (``receiver``);
 * ``PMF_EVERY``: every lamp, and the emissive triangles as one light.
 
 Emission that a BSDF-sampled ray finds (lamps it passes through, suns, emissive
 triangles) is weighted by the power heuristic against the probability that
 next-event estimation from the vertex the ray left would have produced it,
-with the same picking rule.
+with the same picking rule: the receiver the ray left (point and normal) is kept in the
+path state (``mis_p``) so that both sides use the same probabilities.
 """
 from __future__ import annotations
 
@@ -24,7 +26,15 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device
-from .closures.layout import LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
+from .closures.layout import (
+    CL_TYPE,
+    CT_MICROFACET_GLASS,
+    CT_MICROFACET_REFRACTION,
+    CT_TRANSLUCENT,
+    LABEL_DIFFUSE,
+    LABEL_GLOSSY,
+    LABEL_TRANSMIT,
+)
 from .intersect import prim_corners, prim_frame
 from .lights import (
     L_FLAGS,
@@ -40,6 +50,7 @@ from .lights import (
     LF_VIS_GLOSSY,
     LF_VIS_TRANSMISSION,
     LT_SUN,
+    facing_sphere,
     intersect_lamp,
     lamp_importance,
     sample_lamp,
@@ -109,10 +120,26 @@ def pick_light(cdf, u):
 
 
 @device
-def group_importance(group, px, py, pz):
-    """Irradiance estimate of all emissive triangles together: (cx, cy, cz, r^2, scale)."""
+def receiver(hx, hy, hz, nx, ny, nz, cl, ncl):
+    """Where next-event estimation picks a light, for the importances' facing term: the point
+    and its shading normal (facing the viewer), or no normal (0, 0, 0) where a closure
+    transmits (Cycles' SD_BSDF_HAS_TRANSMISSION: light from behind counts there too)."""
+    for k in range(ncl):
+        t = int(cl[k, CL_TYPE])
+        if t == CT_TRANSLUCENT or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+            return hx, hy, hz, 0.0, 0.0, 0.0
+    return hx, hy, hz, nx, ny, nz
+
+
+@device
+def group_importance(group, recv):
+    """Irradiance estimate of all emissive triangles together (group: their bounding sphere
+    cx, cy, cz, r^2, and a scale) at the receiver ``recv`` (see ``lights.lamp_importance``)."""
+    px, py, pz, rx, ry, rz = recv
     dx, dy, dz = px - group[0], py - group[1], pz - group[2]
-    return group[4] / max(dx * dx + dy * dy + dz * dz, group[3])
+    d2 = dx * dx + dy * dy + dz * dz
+    return (group[4] / max(d2, group[3])
+            * facing_sphere(rx, ry, rz, dx, dy, dz, d2, math.sqrt(group[3])))
 
 
 @device
@@ -159,37 +186,37 @@ def nee_exclude(lamp_flags):
 
 
 @device
-def local_light_total(lamps, group, has_group, world, px, py, pz):
-    """Sum of every light's importance at p (lamps, the emissive triangles as one, and the
-    world's constant importance ``world``, 0 when it is not sampled)."""
+def local_light_total(lamps, group, has_group, world, recv):
+    """Sum of every light's importance at the receiver (lamps, the emissive triangles as
+    one, and the world's constant importance ``world``, 0 when it is not sampled)."""
     total = world
     for li in range(lamps.shape[0]):
-        total += lamp_importance(lamps, li, px, py, pz)
+        total += lamp_importance(lamps, li, recv)
     if has_group:
-        total += group_importance(group, px, py, pz)
+        total += group_importance(group, recv)
     return total
 
 
 @device
-def lamp_pick_pmf(lamps, li, pmf_mode, px, py, pz, total):
-    """Probability that next-event estimation at p picks lamp li."""
+def lamp_pick_pmf(lamps, li, pmf_mode, recv, total):
+    """Probability that next-event estimation at the receiver picks lamp li."""
     if pmf_mode == PMF_EVERY:
         return 1.0
     if pmf_mode == PMF_LOCAL:
-        return lamp_importance(lamps, li, px, py, pz) / total if total > 0.0 else 0.0
+        return lamp_importance(lamps, li, recv) / total if total > 0.0 else 0.0
     return lamps[li, L_PMF]
 
 
 @device
-def pick_light_local(lamps, group, has_group, world, px, py, pz, u):
-    """Pick a light at p in proportion to its importance there.
+def pick_light_local(lamps, group, has_group, world, recv, u):
+    """Pick a light at the receiver (point, normal) in proportion to its importance there.
 
     Returns ``(choice, pmf)``: a lamp index, ``n_lamps`` for the emissive
     triangles as a group, or ``n_lamps + 1`` for the world (of importance
     ``world``); ``pmf`` 0 if nothing can light p.
     """
     n_lamps = lamps.shape[0]
-    total = local_light_total(lamps, group, has_group, world, px, py, pz)
+    total = local_light_total(lamps, group, has_group, world, recv)
     if total <= 0.0:
         return 0, 0.0
     target = u * total
@@ -199,14 +226,14 @@ def pick_light_local(lamps, group, has_group, world, px, py, pz, u):
     last = -1
     last_w = 0.0
     for li in range(n_lamps):
-        w = lamp_importance(lamps, li, px, py, pz)
+        w = lamp_importance(lamps, li, recv)
         if w > 0.0:
             acc += w
             last, last_w = li, w
             if target < acc:
                 return li, w / total
     if has_group:
-        return n_lamps, group_importance(group, px, py, pz) / total
+        return n_lamps, group_importance(group, recv) / total
     if last < 0:
         return n_lamps + 1, world / total
     return last, last_w / total      # rounding at the end of the scan
@@ -214,7 +241,7 @@ def pick_light_local(lamps, group, has_group, world, px, py, pz, u):
 
 @device
 def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-                     mpx, mpy, mpz, mis_total, transparent_left):
+                     mp, mis_total, transparent_left):
     """Light from lamps the ray passes through before t_hit (lamps do not block rays).
 
     Lamps are visited nearest first; each one counts as a transparent bounce
@@ -237,7 +264,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
             if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
                 continue
             tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
-                                                  mpx, mpy, mpz)
+                                                  mp[0], mp[1], mp[2])
             if tl > last_t and tl < t_hit:
                 n_hits += 1
                 if tl < best_t:
@@ -247,7 +274,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
             break
         w = 1.0
         if not (flags & PF_MIS_SKIP):
-            pmf = lamp_pick_pmf(lamps, best, pmf_mode, mpx, mpy, mpz, mis_total)
+            pmf = lamp_pick_pmf(lamps, best, pmf_mode, mp, mis_total)
             w = power_heuristic(mis_pdf, pmf * bpdf)
         lr_sum += br * w
         lg_sum += bg * w
@@ -259,7 +286,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
 
 
 @device
-def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total):
+def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total):
     """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
     r = g = b = 0.0
     for li in range(lamps.shape[0]):
@@ -272,7 +299,7 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_to
         if lpdf > 0.0:
             w = 1.0
             if not (flags & PF_MIS_SKIP):
-                pmf = lamp_pick_pmf(lamps, li, pmf_mode, mpx, mpy, mpz, mis_total)
+                pmf = lamp_pick_pmf(lamps, li, pmf_mode, mp, mis_total)
                 w = power_heuristic(mis_pdf, pmf * lpdf)
             r += lr * w
             g += lg * w

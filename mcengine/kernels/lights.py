@@ -234,17 +234,52 @@ def area_spread(lamps, li, cos_l):
 
 
 @device
-def lamp_importance(lamps, li, px, py, pz):
-    """Rough irradiance lamp li gives at p, ignoring occlusion and the surface's facing.
+def facing(rx, ry, rz, wx, wy, wz, cos_u, sin_u):
+    """Cycles' cos(theta_i') of its light tree: the largest cosine between the receiver's
+    normal r and a direction within angle u of the unit direction w to the light (u: the
+    half-angle the light's bounding sphere, or a sun's disk, subtends); 0 when the whole
+    light lies behind the surface.  1 without a normal (r = 0: a surface that transmits)."""
+    if rx == 0.0 and ry == 0.0 and rz == 0.0:
+        return 1.0
+    cos_i = rx * wx + ry * wy + rz * wz
+    if cos_i >= cos_u:
+        return 1.0
+    sin_i = math.sqrt(max(1.0 - cos_i * cos_i, 0.0))
+    return max(cos_i * cos_u + sin_i * sin_u, 0.0)
 
-    Used to pick the light for next-event estimation at p: near lamps and
-    spots pointing at p are picked more often.  Zero only where the lamp
-    cannot contribute at all (behind a one-sided area light).
+
+@device
+def facing_sphere(rx, ry, rz, dx, dy, dz, d2, radius):
+    """:func:`facing` of a sphere of ``radius`` at offset -d (d: from it to the receiver)."""
+    if rx == 0.0 and ry == 0.0 and rz == 0.0:
+        return 1.0
+    if d2 <= radius * radius:
+        return 1.0
+    d = math.sqrt(d2)
+    sin_u = radius / d
+    return facing(rx, ry, rz, -dx / d, -dy / d, -dz / d, math.sqrt(1.0 - sin_u * sin_u), sin_u)
+
+
+@device
+def lamp_importance(lamps, li, recv):
+    """Rough irradiance lamp li gives at the receiver, ignoring occlusion.
+
+    ``recv`` is (point, normal): the normal facing the viewer, or 0 where the surface
+    transmits.  Used to pick the light for next-event estimation there: near lamps, spots
+    pointing at it and lamps in front of the surface are picked more often.  Zero only where
+    the lamp cannot contribute (behind a one-sided area light, or wholly behind an opaque
+    surface: Cycles' light tree gives those no importance either; the BSDF's own normal, if
+    bumped, may still see it, and BSDF sampling then finds it with MIS weight 1).
     """
     k = lamps[li, L_IMPORTANCE]
     typ = int(lamps[li, L_TYPE])
-    if k <= 0.0 or typ == LT_SUN:
+    if k <= 0.0:
         return k
+    px, py, pz, rx, ry, rz = recv
+    if typ == LT_SUN:
+        omc = lamps[li, L_SUN_OMC]
+        return k * facing(rx, ry, rz, lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2],
+                          1.0 - omc, math.sqrt(max(omc * (2.0 - omc), 0.0)))
     dx, dy, dz = px - lamps[li, L_POS], py - lamps[li, L_POS + 1], pz - lamps[li, L_POS + 2]
     d2 = dx * dx + dy * dy + dz * dz
     if typ == LT_AREA:
@@ -252,12 +287,15 @@ def lamp_importance(lamps, li, px, py, pz):
         if s <= 0.0:
             return 0.0            # behind the emitting side: no light at all
         cos_l = s / math.sqrt(d2)
-        return k * max(cos_l, IMPORTANCE_FLOOR) / max(d2, lamps[li, L_AREA])
+        radius = math.sqrt(lamps[li, L_HALF_X] ** 2 + lamps[li, L_HALF_Y] ** 2)
+        return (k * max(cos_l, IMPORTANCE_FLOOR) / max(d2, lamps[li, L_AREA])
+                * facing_sphere(rx, ry, rz, dx, dy, dz, d2, radius))
     att = 1.0
     if typ == LT_SPOT:
         att = max(spot_attenuation(lamps, li, dx, dy, dz), IMPORTANCE_FLOOR)
     r = lamps[li, L_RADIUS]
-    return k * att / max(d2, r * r, 1e-12)
+    return (k * att / max(d2, r * r, 1e-12)
+            * facing_sphere(rx, ry, rz, dx, dy, dz, d2, r))
 
 
 @device

@@ -64,7 +64,14 @@ from .closures.layout import (
     SSS_BURLEY,
 )
 from .intersect import offset_origin, offset_scale
-from .light_sampling import PMF_GLOBAL, PMF_LOCAL, local_light_total, pick_light, pick_light_local
+from .light_sampling import (
+    PMF_GLOBAL,
+    PMF_LOCAL,
+    local_light_total,
+    pick_light,
+    pick_light_local,
+    receiver,
+)
 from .passes import (
     LK_BACKGROUND,
     LK_SURFACE,
@@ -215,11 +222,12 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, st.ray_tmax[i], st.time[i])
         direct = st.bounce[i] <= 1   # clamp index (bounce - 1) <= 0
         # Light-picking probabilities at the vertex this ray left, for MIS.
-        mpx, mpy, mpz = st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2]
+        mp = (st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2],
+              st.mis_p[i, 3], st.mis_p[i, 4], st.mis_p[i, 5])
         mis_total = 0.0
         if local and mis and not (flags & PF_MIS_SKIP):
             mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, world_importance,
-                                          mpx, mpy, mpz)
+                                          mp)
 
         # -- light arriving along the ray ------------------------------------------------------
         if lamps_hit and not exit_walk:
@@ -227,7 +235,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             passed = light_from_lamps(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i,
                                       ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-                                      mpx, mpy, mpz, mis_total, st.transparent[i], direct)
+                                      mp, mis_total, st.transparent[i], direct)
             if passed:
                 if light_passes:
                     _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
@@ -244,7 +252,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_BACKGROUND)
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_suns(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz, flags,
-                            mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct)
+                            mis_pdf, pmf_mode, mp, mis_total, direct)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
             background_passes(pd, fp, st.pixel[i], flags)
@@ -258,7 +266,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             continue   # a terminated path only collects emission, and there is none
         # The ray's length from the vertex it left (transparent surfaces may lie between):
         # Light Path's Ray Length and the emission's MIS distance.
-        hx, hy, hz = sp.hx - mpx, sp.hy - mpy, sp.hz - mpz
+        hx, hy, hz = sp.hx - mp[0], sp.hy - mp[1], sp.hz - mp[2]
         ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
         depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
         footprint = st.dp[i] + st.dd[i] * ray_length     # Cycles' differential_transfer_compact
@@ -298,7 +306,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 if light_passes:
                     r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
                 light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
-                                   ray_length, sp, flags, mis_pdf, pmf_mode, mpx, mpy, mpz,
+                                   ray_length, sp, flags, mis_pdf, pmf_mode, mp,
                                    mis_total, direct, res.er, res.eg, res.eb)
                 if light_passes:
                     _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
@@ -334,11 +342,16 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                     depths, max_transparent - st.transparent[i])
 
         # -- next-event estimation: one light --------------------------------------------------
+        # Where lights are picked (the point and, on opaque surfaces, its normal); the next ray
+        # keeps it for the MIS weights of the light it finds.
+        recv = (sp.hx, sp.hy, sp.hz, 0.0, 0.0, 0.0)
+        if local:
+            recv = receiver(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, scratch.cl, ncl)
         if nee:
             lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
             if local:
                 idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, world_importance,
-                                            sp.hx, sp.hy, sp.hz, u_pick)
+                                            recv, u_pick)
                 if idx == n_lamps + 1:
                     idx = world_light
                 elif idx == n_lamps:
@@ -392,7 +405,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 new_flags |= PF_CAUSTIC_EYE     # x1 can be joined to the camera (light_tracing)
             st.flags[i] = count_bounce(st, i, cfg, new_flags, ds.label)
             st.mis_pdf[i] = ds.pdf
-            st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = sp.hx, sp.hy, sp.hz
+            for c in range(6):
+                st.mis_p[i, c] = recv[c]
             st.dp[i] = footprint     # Cycles keeps the camera's dD at every bounce
             if ds.pdf > 0.0:
                 st.min_pdf[i] = min(st.min_pdf[i], ds.pdf)

@@ -20,8 +20,9 @@ Light is added with ``add_light`` to row ``row`` of an (N, >=3) array ``out``
 weighted by the throughput ``beta[i]``.  ``direct`` selects Cycles' direct
 or indirect clamp.  ``pmf_mode`` says how next-event estimation picks lights
 (see ``light_sampling``), which the MIS weights of emission found by rays
-must follow; ``mpx, mpy, mpz`` is the vertex the ray left and ``mis_total``
-the sum of light importances there (``PMF_LOCAL`` only).
+must follow; ``mp`` is the receiver the ray left (the vertex and its normal for the
+importances' facing term, ``light_sampling.receiver``) and ``mis_total`` the sum of light
+importances there (``PMF_LOCAL`` only).
 
 Every step is inlined into its kernel (``jit.device``), so sharing costs
 nothing at run time.
@@ -249,7 +250,7 @@ def next_path_flags(flags, label):
 # -- 1-3. light arriving along the ray ---------------------------------------------------------
 @device
 def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy, dz, t_hit,
-                     flags, mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, transparent, direct):
+                     flags, mis_pdf, pmf_mode, mp, mis_total, transparent, direct):
     """Add the light of lamps the ray passes before t_hit; returns how many it passed.
 
     Each lamp passed counts as a transparent bounce (Cycles), at most as many
@@ -257,7 +258,7 @@ def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy
     """
     lr, lg, lb, passed = lamps_on_segment(
         sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-        mpx, mpy, mpz, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent)
+        mp, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent)
     if passed:
         add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg, stats)
     return passed
@@ -265,7 +266,7 @@ def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy
 
 @device
 def light_from_background(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz, flags,
-                          mis_pdf, pmf_mode, mpx, mpy, mpz, mis_total, direct):
+                          mis_pdf, pmf_mode, mp, mis_total, direct):
     """Add the world's and the suns' light to an escaped ray.
 
     Returns the film transparency it leaves: on a transparent film a camera
@@ -275,7 +276,7 @@ def light_from_background(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, 
     transparency = light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz,
                                     flags, mis_pdf, pmf_mode, mis_total, direct)
     light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
-                    pmf_mode, mpx, mpy, mpz, mis_total, direct)
+                    pmf_mode, mp, mis_total, direct)
     return transparency
 
 
@@ -303,24 +304,24 @@ def light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, d
 
 @device
 def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf, pmf_mode,
-                    mpx, mpy, mpz, mis_total, direct):
+                    mp, mis_total, direct):
     """The suns' part of ``light_from_background``: suns with an angle seen by the ray."""
     if sc.lamps.shape[0] and cfg[CFG_LAMPS_HIT]:
         lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
-                               mpx, mpy, mpz, mis_total)
+                               mp, mis_total)
         if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
                       stats)
 
 
 @device
-def emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total):
+def emitter_group_scale(sc, fcfg, pmf_mode, mp, mis_total):
     """Factor from an emissive triangle's scene-wide pick probability (``emit_pmf``)
     to the probability that next-event estimation at m picked it."""
     if pmf_mode == PMF_EVERY:
         return fcfg[FCFG_EMIT_SCALE]
     if pmf_mode == PMF_LOCAL and mis_total > 0.0:
-        return group_importance(sc.emit_group, mpx, mpy, mpz) / mis_total * fcfg[FCFG_EMIT_SCALE]
+        return group_importance(sc.emit_group, mp) / mis_total * fcfg[FCFG_EMIT_SCALE]
     return 1.0
 
 
@@ -421,9 +422,9 @@ def emission_estimates(sc, scratch, tris, out):
 
 @device
 def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, sp, flags, mis_pdf,
-                       pmf_mode, mpx, mpy, mpz, mis_total, direct, er, eg, eb):
+                       pmf_mode, mp, mis_total, direct, er, eg, eb):
     """Add emission (er, eg, eb) of triangle p, seen by the ray at ``sp``, MIS-weighted."""
-    scale = emitter_group_scale(sc, fcfg, pmf_mode, mpx, mpy, mpz, mis_total)
+    scale = emitter_group_scale(sc, fcfg, pmf_mode, mp, mis_total)
     w = emission_weight(sc.tri_light, sc.emit_pmf, sp.area, p, t_hit, sp.cos_o, flags,
                         mis_pdf, scale)
     add_light(out, row, beta[i, 0] * er * w, beta[i, 1] * eg * w, beta[i, 2] * eb * w, direct,

@@ -34,7 +34,8 @@ PathState = namedtuple("PathState", [
     "flags",         # (B,) int32    PF_* bits
     "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
     "min_pdf",       # (B,) f64      smallest BSDF pdf on the path so far (Filter Glossy)
-    "mis_p",         # (B, 3) f64    the vertex that ray left (light picking there, for MIS)
+    "mis_p",         # (B, 6) f64    the receiver that ray left: vertex, normal (0: none; light
+                     #               picking there, for MIS: light_sampling.receiver)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
     "dp",            # (B,) f64      ray differential: footprint at mis_p (Cycles' compact ray dP)
     "dd",            # (B,) f64      its growth per unit length (the camera's compact dD)
@@ -197,7 +198,7 @@ def alloc_path_state(n: int) -> PathState:
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
-        mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 3)), self_prim=np.zeros(n, np.int32),
+        mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 6)), self_prim=np.zeros(n, np.int32),
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
@@ -215,6 +216,7 @@ def move_path(st, i, m):
         st.beta[m, c] = st.beta[i, c]
         st.radiance[m, c] = st.radiance[i, c]
         st.mis_p[m, c] = st.mis_p[i, c]
+        st.mis_p[m, c + 3] = st.mis_p[i, c + 3]
         st.o32[m, c] = st.o32[i, c]
         st.d32[m, c] = st.d32[i, c]
     st.ray_tmax[m] = st.ray_tmax[i]

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from mcengine.scene import Geometry, Light, Material
+from mcengine.scene import Geometry, Light, Link, Material, ShaderNode
 
 from .expect import assert_mean, render
 from .scenes import grid_plane, plane_scene, rotation_x, translation
@@ -324,3 +324,47 @@ def test_negative_lamps_remove_light_as_in_cycles():
     scene.lights.append(Light(type="POINT", matrix_world=translation(0, 0, H),
                               strength=(2 * P,) * 3))
     assert_mean(render(scene), lambert(E), max_rel_se=0.01)
+
+
+def _relative_pixel_sd(session):
+    """Mean over pixels of each pixel's standard deviation of one sample, over its mean."""
+    img = session.image()[..., 0].astype(np.float64)
+    var = session.variance()[..., 0].astype(np.float64) * session.pass_samples
+    return float(np.mean(np.sqrt(var) / img))
+
+
+def test_lights_behind_an_opaque_surface_are_never_picked():
+    """Cycles' light-tree facing term: a light wholly behind the surface (a strong point
+    lamp under the plane, a sun shining from below) lights nothing there, and next-event
+    estimation never picks it, so the noise is that of the lamp above alone.  Without the
+    term the lamp below, 20 times the estimated irradiance, would take ~95 % of the samples
+    and the noise would be several times larger.  The mean stays the lamp above's."""
+    above = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P,) * 3, radius=0.5)
+    below = [Light(type="POINT", matrix_world=translation(0.3, 0, -1.0), strength=(20 * P,) * 3),
+             Light(type="SUN", matrix_world=rotation_x(math.pi), strength=(3.0,) * 3,
+                   angle=math.radians(10))]
+    alone = plane_scene(above, samples=256, size=0.5)
+    both = plane_scene(above, samples=256, size=0.5)
+    both.lights = [above] + below
+    s_alone, s_both = render(alone), render(both)
+    from mcengine.kernels.state import CFG_LOCAL_LIGHTS
+    assert s_both.cfg[CFG_LOCAL_LIGHTS] == 1
+    assert_mean(s_both, float(s_alone.image()[..., 0].mean()), max_rel_se=0.01)
+    ratio = _relative_pixel_sd(s_both) / _relative_pixel_sd(s_alone)
+    assert ratio < 1.15, f"noise {ratio:.2f} times that of the lamp above alone"
+
+
+def test_a_translucent_surface_picks_lights_on_both_sides():
+    """A surface that transmits (Cycles' SD_BSDF_HAS_TRANSMISSION) has no facing term: a
+    Translucent plane lit by a point lamp below it glows on top with that lamp's irradiance
+    x colour / pi (a point lamp is never hit by a ray: were it left out of the picking, the
+    plane would stay black); a lamp above adds nothing to its transmitted light."""
+    lamp_below = Light(type="POINT", matrix_world=translation(0, 0, -H), strength=(P,) * 3)
+    lamp_above = Light(type="POINT", matrix_world=translation(0, 0, H), strength=(P,) * 3)
+    scene = plane_scene(lamp_below, samples=512)
+    scene.lights = [lamp_below, lamp_above]
+    scene.materials = [Material(name="translucent",
+                                nodes=[ShaderNode("BsdfTranslucent", {"Color": (0.5, 0.5, 0.5)})],
+                                surface=Link(0, "BSDF"))]
+    s = render(scene)
+    assert_mean(s, 0.5 * lambert(P / (4 * math.pi * H * H)), max_rel_se=0.01)

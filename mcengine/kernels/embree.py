@@ -9,6 +9,11 @@ the share of worker time spent here).  Where the library cannot be found (a plat
 embreex wheel puts it elsewhere), :func:`build` falls back to embreex's own Python API,
 single rays at a time, with the same answers.
 
+Subsurface walks trace one ray at a time from inside a compiled kernel: each object with a
+subsurface material gets a scene of its own (:func:`build_local`), traced with
+``rtcIntersect1`` through :func:`intersect_one`; without the library, ``kernels.subsurface``
+keeps compiled hierarchies of its own.
+
 Both use Embree's robust mode: its watertight triangle test.  The fast mode lets about one
 ray in ten aimed exactly at a shared edge or vertex slip between the triangles
 (tests/core/test_intersect.py), a light leak in closed rooms; robust costs ~25 % more per ray.
@@ -135,8 +140,7 @@ def build_local(vertices, triangles):
 
     Returns ``(scene, handle, rtcIntersect1's address)``; the scene object owns the handle
     (keep it alive while compiled code uses the handle); primitive ids are rows of
-    ``triangles``.  Only the vertices the triangles
-    use are copied.
+    ``triangles``.  Only the vertices the triangles use are copied.
     """
     library = _load()
     if library is None:
@@ -147,7 +151,9 @@ def build_local(vertices, triangles):
 
 
 class _PacketScene:
-    """The scene built through the library's C API, traced in packets from compiled code."""
+    """The scene built through the library's C API: ``closest`` and ``occluded`` trace in
+    packets from compiled code; compiled code may also trace its handle (``_scene``) one ray
+    at a time (:func:`intersect_one`)."""
 
     def __init__(self, library: _Library, vertices, triangles):
         lib = library.lib

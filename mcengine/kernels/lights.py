@@ -268,8 +268,9 @@ def lamp_importance(lamps, li, recv):
     transmits.  Used to pick the light for next-event estimation there: near lamps, spots
     pointing at it and lamps in front of the surface are picked more often.  Zero only where
     the lamp cannot contribute (behind a one-sided area light, or wholly behind an opaque
-    surface: Cycles' light tree gives those no importance either; the BSDF's own normal, if
-    bumped, may still see it, and BSDF sampling then finds it with MIS weight 1).
+    surface).  As in Cycles' light tree the normal is the shading point's, not a bumped
+    closure's: a closure whose own normal sees such a lamp gets its light only from rays that
+    hit it (MIS weight 1), none from a point lamp of radius 0 or a sun without angle.
     """
     k = lamps[li, L_IMPORTANCE]
     typ = int(lamps[li, L_TYPE])

@@ -26,15 +26,8 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device
-from .closures.layout import (
-    CL_TYPE,
-    CT_MICROFACET_GLASS,
-    CT_MICROFACET_REFRACTION,
-    CT_TRANSLUCENT,
-    LABEL_DIFFUSE,
-    LABEL_GLOSSY,
-    LABEL_TRANSMIT,
-)
+from .closures import has_transmission
+from .closures.layout import CL_TYPE, LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
 from .intersect import prim_corners, prim_frame
 from .lights import (
     L_FLAGS,
@@ -125,8 +118,7 @@ def receiver(hx, hy, hz, nx, ny, nz, cl, ncl):
     and its shading normal (facing the viewer), or no normal (0, 0, 0) where a closure
     transmits (Cycles' SD_BSDF_HAS_TRANSMISSION: light from behind counts there too)."""
     for k in range(ncl):
-        t = int(cl[k, CL_TYPE])
-        if t == CT_TRANSLUCENT or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
+        if has_transmission(int(cl[k, CL_TYPE])):
             return hx, hy, hz, 0.0, 0.0, 0.0
     return hx, hy, hz, nx, ny, nz
 

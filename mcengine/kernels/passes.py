@@ -41,7 +41,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device, function
-from .closures import closure_eval, excluded, is_diffuse
+from .closures import closure_eval, excluded, is_diffuse, is_glossy_reflection
 from .closures.layout import (
     CL_AX,
     CL_AY,
@@ -56,7 +56,6 @@ from .closures.layout import (
     CT_MICROFACET_REFRACTION,
     CT_NONE,
     CT_TRANSPARENT,
-    CT_VELVET,
     LABEL_REFLECT,
     ROUGHNESS_SQ_THRESHOLD,
 )
@@ -184,7 +183,7 @@ def _pass_kind(cl, k, t, wix, wiy, wiz):
     on the side of its normal), 2 transmission."""
     if is_diffuse(t):
         return 0
-    if t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET or (t == CT_MICROFACET_GLASS and (
+    if is_glossy_reflection(t) or (t == CT_MICROFACET_GLASS and (
             wix * cl[k, CL_N] + wiy * cl[k, CL_N + 1] + wiz * cl[k, CL_N + 2]) > 0.0):
         return 1
     return 2
@@ -462,7 +461,7 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
             t = cl[k, CL_TYPE]
             if is_diffuse(t) or t == CT_BSSRDF:    # Cycles' surface_shader_diffuse
                 o, refl, trans = c[P_DIFFUSE_COLOR], True, True
-            elif t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET:
+            elif is_glossy_reflection(t):
                 o, refl, trans = c[P_GLOSSY_COLOR], True, False
             elif t == CT_MICROFACET_REFRACTION:
                 o, refl, trans = c[P_TRANSMISSION_COLOR], False, True

@@ -141,14 +141,20 @@ def local_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip):
             p = lb.tris[e]
             if p == skip:
                 continue
-            a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
-            t = hit_triangle(ox, oy, oz, dx, dy, dz, verts[a, 0], verts[a, 1], verts[a, 2],
-                             verts[b, 0], verts[b, 1], verts[b, 2], verts[c, 0], verts[c, 1],
-                             verts[c, 2])
+            t = _hit_prim(verts, tris, p, ox, oy, oz, dx, dy, dz)
             if t < best:
                 best, found = t, p
         k += 1
     return best, found
+
+
+@device
+def _hit_prim(verts, tris, p, ox, oy, oz, dx, dy, dz):
+    """``motion.hit_triangle`` on triangle p of the scene tables (float64)."""
+    a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
+    return hit_triangle(ox, oy, oz, dx, dy, dz, verts[a, 0], verts[a, 1], verts[a, 2],
+                        verts[b, 0], verts[b, 1], verts[b, 2], verts[c, 0], verts[c, 1],
+                        verts[c, 2])
 
 
 @device
@@ -166,10 +172,7 @@ def _embree_closest(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, skip):
             return tmax, -1
         p = lb.tris[lb.first[obj] + q]
         if p != skip:
-            a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
-            t = hit_triangle(ox, oy, oz, dx, dy, dz, verts[a, 0], verts[a, 1], verts[a, 2],
-                             verts[b, 0], verts[b, 1], verts[b, 2], verts[c, 0], verts[c, 1],
-                             verts[c, 2])
+            t = _hit_prim(verts, tris, p, ox, oy, oz, dx, dy, dz)
             # Embree's watertight float32 test may find a hit the float64 one misses at an edge.
             return (t if t < math.inf else min(t32, tmax)), p
         tnear = t32 * (1.0 + 2.0 ** -22) + 1e-30

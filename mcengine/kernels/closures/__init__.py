@@ -105,6 +105,20 @@ def is_diffuse(t):
 
 
 @device
+def is_glossy_reflection(t):
+    """Whether closures of type t only reflect, glossily (microfacet reflection,
+    Ashikhmin-Shirley, and the velvet, which Cycles labels glossy)."""
+    return t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET
+
+
+@device
+def has_transmission(t):
+    """Whether closures of type t send light through the surface (Cycles'
+    SD_BSDF_HAS_TRANSMISSION: translucent, microfacet refraction and glass)."""
+    return t == CT_TRANSLUCENT or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS
+
+
+@device
 def bump_shadowing(cl, k, diffuse, is_eval, wix, wiy, wiz):
     """Cycles' bump_shadowing_term: the factor on closure k's value towards wi when its normal
     N differs from the point's smooth normal Ns.
@@ -248,8 +262,8 @@ def excluded(t, exclude):
         return False
     if is_diffuse(t):
         return (exclude & LABEL_DIFFUSE) != 0
-    if t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET:
-        return (exclude & LABEL_GLOSSY) != 0    # velvet is glossy here, as in Cycles
+    if is_glossy_reflection(t):
+        return (exclude & LABEL_GLOSSY) != 0
     if t == CT_MICROFACET_REFRACTION:
         return (exclude & LABEL_TRANSMIT) != 0
     if t == CT_MICROFACET_GLASS:

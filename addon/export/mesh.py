@@ -635,7 +635,10 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
         tm.polygons.add(t)
         tm.polygons.foreach_set("loop_start", np.arange(0, 3 * t, 3, dtype=np.int32))
         tm.update(calc_edges=True)
-        tm.normals_split_custom_set(np.asarray(corner_normals, np.float32).tolist())
+        # The normals as a float attribute ("free" custom normals): exact, where
+        # normals_split_custom_set would encode them in 16 bits, through a Python list.
+        custom = tm.attributes.new("custom_normal", "FLOAT_VECTOR", "CORNER")
+        custom.data.foreach_set("vector", np.ascontiguousarray(corner_normals, np.float32).ravel())
         for k, (name, table) in enumerate(layers.items()):
             # A layer per map: Blender keeps the tangents it computed for a layer's name.
             uv = tm.uv_layers.new(name=f"uv{k}")

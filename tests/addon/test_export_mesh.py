@@ -420,6 +420,30 @@ def test_normal_maps_get_the_tangents_of_their_uv_map(scene, fake_session):
     np.testing.assert_allclose(np.abs(tangent[:, 3]), 1.0)
 
 
+def test_tangents_of_a_mesh_with_custom_normals_are_blenders_own(scene, fake_session):
+    """On a mesh of triangles with custom normals (each corner its own) the exported
+    tangents are those ``calc_tangents`` gives for the mesh itself, to float precision:
+    the export's copy of the mesh keeps the corner normals exactly."""
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2)
+    me = bpy.context.object.data
+    rng = np.random.default_rng(3)
+    me.shade_smooth()
+    normals = np.empty(3 * len(me.loops), np.float32)
+    me.corner_normals.foreach_get("vector", normals)
+    normals = normals.reshape(-1, 3) + 0.2 * rng.normal(size=(len(me.loops), 3))
+    me.normals_split_custom_set((normals / np.linalg.norm(normals, axis=1)[:, None]).tolist())
+    me.uv_layers.active.uv.foreach_set("vector", rng.random(2 * len(me.loops)))
+    me.materials.append(_normal_map_material())
+    tangent = export_scene(fake_session).geometry.attributes["tangent:"].reshape(-1, 4)
+    me.calc_tangents()
+    me.calc_loop_triangles()
+    loops = np.empty(3 * len(me.loop_triangles), np.int32)
+    me.loop_triangles.foreach_get("loops", loops)
+    expected = np.empty(3 * len(me.loops), np.float32)
+    me.loops.foreach_get("tangent", expected)
+    np.testing.assert_allclose(tangent[:, :3], expected.reshape(-1, 3)[loops], atol=1e-6)
+
+
 def test_tangent_nodes_along_a_uv_map_get_its_tangents(scene, fake_session):
     """A Tangent node along a UV map reads the same tangents; a radial one none."""
     ob = new_mesh_object("Quad", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])

@@ -22,6 +22,7 @@ from .features import detect as detect_plan
 from .images import ImageTable
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
+from .kernels.light_tree import build_emitter_tree, no_tree
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
 from .kernels.motion import pack_motion
 from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, P_VECTOR, PassData
@@ -138,7 +139,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
-        emit_cdf=np.zeros(1), emit_group=np.zeros(5), tri_light=np.full(len(tris), -1, np.int32),
+        emit_cdf=np.zeros(1), emit_group=np.zeros((1, 5)), emit_tree=no_tree(),
+        tri_light=np.full(len(tris), -1, np.int32),
         tri_area=tri_area, tri_normal=tri_normal,
         world=shaders.emission[world].copy(), camera=camera,
         filter_table=filter_table(film.filter_type, film.filter_width),
@@ -189,13 +191,18 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         emit_cdf /= emit_cdf[-1]
     # The emissive triangles as one light for per-point picking: its centre,
     # its radius squared (the distance floor) and an irradiance scale.
-    emit_group = np.zeros(5)
+    # And the light tree that picks one of them at a point, unless some of them move.
+    emit_group = np.zeros((1, 5))
+    emit_tree = no_tree()
     if len(emit_tri):
-        corners = verts[tris[emit_tri]].reshape(-1, 3)
-        lo_e, hi_e = corners.min(axis=0), corners.max(axis=0)
-        emit_group[:3] = 0.5 * (lo_e + hi_e)
-        emit_group[3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
-        emit_group[4] = emit_power.sum() / math.pi
+        corners = verts[tris[emit_tri]]
+        lo_e, hi_e = corners.reshape(-1, 3).min(axis=0), corners.reshape(-1, 3).max(axis=0)
+        emit_group[0, :3] = 0.5 * (lo_e + hi_e)
+        emit_group[0, 3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
+        emit_group[0, 4] = emit_power.sum() / math.pi
+        slots = sc.motion.tri_slot
+        if not (len(slots) and np.any(slots[emit_tri] >= 0)):
+            emit_tree = build_emitter_tree(corners, emit_power)
     if len(lamps):
         lamps[:, L_PMF] = lamp_pmf
         if not lamps_intersectable(scene.lights):
@@ -219,7 +226,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
 
     x0, y0, x1, y1 = film.window
     sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,
-                     emit_cdf=emit_cdf, emit_group=emit_group, tri_light=tri_light)
+                     emit_cdf=emit_cdf, emit_group=emit_group, emit_tree=emit_tree,
+                     tri_light=tri_light)
 
     it = scene.integrator
     cfg = np.zeros(CFG_SIZE, np.int64)
@@ -249,11 +257,12 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     fcfg[FCFG_EMIT_SCALE] = 1.0 / emit_share if emit_share > 0 else 0.0
     fcfg[FCFG_WORLD_PMF] = world_pmf
     fcfg[FCFG_WORLD_IMPORTANCE] = world_importance
-    # Per-point light picking pays for itself when there is a choice to make and
-    # the scan over lamps stays short.
+    # Per-point light picking pays for itself when there is a choice to make (among the
+    # lights, or among the emissive triangles by the tree) and the scan over lamps stays short.
     n_choices = (int(np.count_nonzero(lamp_power)) + (1 if len(emit_tri) else 0)
                  + (1 if world_power > 0.0 else 0))
-    cfg[CFG_LOCAL_LIGHTS] = 1 if 2 <= n_choices and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
+    choice = 2 <= n_choices or len(emit_tree.rank) > 1
+    cfg[CFG_LOCAL_LIGHTS] = 1 if choice and len(lamps) <= LOCAL_PICK_MAX_LAMPS else 0
     return PackedScene(sc, cfg, fcfg, plan)
 
 

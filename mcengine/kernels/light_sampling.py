@@ -8,8 +8,8 @@ at a shading point picks one light (path tracing) or visits every light
   triangles" in proportion to an estimate of their power;
 * ``PMF_LOCAL``: in proportion to each light's estimated irradiance at the
   point (``lamp_importance``), the emissive triangles counting as one light
-  (then one triangle by power), times Cycles' light-tree facing term: lights
-  wholly behind an opaque surface are not picked (``receiver``);
+  (then one triangle by the light tree, ``light_tree``), times Cycles' light-tree
+  facing term: lights wholly behind an opaque surface are not picked (``receiver``);
 * ``PMF_EVERY``: every lamp, and the emissive triangles as one light.
 
 Emission that a BSDF-sampled ray finds (lamps it passes through, suns, emissive
@@ -29,6 +29,7 @@ from ..jit import device
 from .closures import has_transmission
 from .closures.layout import CL_TYPE, LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_TRANSMIT
 from .intersect import prim_corners, prim_frame
+from .light_tree import sphere_importance, tree_pick, tree_pmf
 from .lights import (
     L_FLAGS,
     L_MAX_BOUNCES,
@@ -43,7 +44,6 @@ from .lights import (
     LF_VIS_GLOSSY,
     LF_VIS_TRANSMISSION,
     LT_SUN,
-    facing_sphere,
     intersect_lamp,
     lamp_importance,
     sample_lamp,
@@ -51,6 +51,7 @@ from .lights import (
 )
 from .sampling import power_heuristic, uniform_triangle
 from .state import (
+    FCFG_EMIT_SCALE,
     PF_CAMERA,
     PF_CAUSTIC_EYE,
     PF_DIFFUSE,
@@ -124,17 +125,6 @@ def receiver(hx, hy, hz, nx, ny, nz, cl, ncl):
 
 
 @device
-def group_importance(group, recv):
-    """Irradiance estimate of all emissive triangles together (group: their bounding sphere
-    cx, cy, cz, r^2, and a scale) at the receiver ``recv`` (see ``lights.lamp_importance``)."""
-    px, py, pz, rx, ry, rz = recv
-    dx, dy, dz = px - group[0], py - group[1], pz - group[2]
-    d2 = dx * dx + dy * dy + dz * dz
-    return (group[4] / max(d2, group[3])
-            * facing_sphere(rx, ry, rz, dx, dy, dz, d2, math.sqrt(group[3])))
-
-
-@device
 def sample_triangle_point(sc, tri, u1, u2, time):
     """Uniform point on triangle ``tri`` as it is at ``time``: (x, y, z, b1, b2)."""
     b1, b2 = uniform_triangle(u1, u2)
@@ -185,7 +175,7 @@ def local_light_total(lamps, group, has_group, world, recv):
     for li in range(lamps.shape[0]):
         total += lamp_importance(lamps, li, recv)
     if has_group:
-        total += group_importance(group, recv)
+        total += sphere_importance(group, 0, recv)
     return total
 
 
@@ -225,7 +215,7 @@ def pick_light_local(lamps, group, has_group, world, recv, u):
             if target < acc:
                 return li, w / total
     if has_group:
-        return n_lamps, group_importance(group, recv) / total
+        return n_lamps, sphere_importance(group, 0, recv) / total
     if last < 0:
         return n_lamps + 1, world / total
     return last, last_w / total      # rounding at the end of the scan
@@ -300,15 +290,43 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total):
 
 
 @device
-def emission_weight(tri_light, emit_pmf, area, p, t_hit, cos_o_geo, flags, mis_pdf,
-                    emit_pmf_scale):
+def pick_emitter(sc, fcfg, recv, u):
+    """Pick one of the emissive triangles, once next-event estimation at the receiver chose
+    them as a group: ``(j, pmf)`` (j indexes ``emit_tri``; -1 when none can light it), by
+    the light tree where the scene has one, else by power."""
+    if sc.emit_tree.nodes.shape[0] > 0:
+        return tree_pick(sc.emit_tree, recv, u)
+    j = pick_light(sc.emit_cdf, u)
+    return j, sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+
+
+@device
+def emitter_pick_pmf(sc, fcfg, pmf_mode, mp, mis_total, j):
+    """The probability that next-event estimation at the receiver ``mp`` picked emissive
+    triangle j (``mis_total``: the lights' summed importance there, for ``PMF_LOCAL``)."""
+    if pmf_mode == PMF_EVERY:
+        return sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+    if pmf_mode == PMF_LOCAL:
+        if not mis_total > 0.0:
+            return 0.0
+        group = sphere_importance(sc.emit_group, 0, mp) / mis_total
+        if sc.emit_tree.nodes.shape[0] > 0:
+            return group * tree_pmf(sc.emit_tree, j, mp)
+        return group * sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+    return sc.emit_pmf[j]
+
+
+@device
+def emission_weight(sc, fcfg, p, area, t_hit, cos_o_geo, flags, mis_pdf, pmf_mode, mp,
+                    mis_total):
     """MIS weight of emission found by a BSDF ray on emissive triangle p (of that ``area``)."""
     if flags & PF_MIS_SKIP:
         return 1.0
-    j = tri_light[p]
+    j = sc.tri_light[p]
     if j < 0:
         return 1.0
-    light_pdf = emit_pmf[j] * emit_pmf_scale * t_hit * t_hit / (area * cos_o_geo)
+    light_pdf = (emitter_pick_pmf(sc, fcfg, pmf_mode, mp, mis_total, j)
+                 * t_hit * t_hit / (area * cos_o_geo))
     return power_heuristic(mis_pdf, light_pdf)
 
 

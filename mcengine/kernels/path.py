@@ -68,6 +68,7 @@ from .light_sampling import (
     PMF_GLOBAL,
     PMF_LOCAL,
     local_light_total,
+    pick_emitter,
     pick_light,
     pick_light_local,
     receiver,
@@ -130,7 +131,6 @@ from .state import (
     CFG_SAMPLER,
     CFG_SOBOL_MASK,
     CFG_SUBSURFACE,
-    FCFG_EMIT_SCALE,
     FCFG_FILTER_GLOSSY,
     FCFG_WORLD_IMPORTANCE,
     MF_BUMP_CORRECTION,
@@ -355,9 +355,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 if idx == n_lamps + 1:
                     idx = world_light
                 elif idx == n_lamps:
-                    j = pick_light(sc.emit_cdf, u_group)
-                    idx = n_lamps + j
-                    pmf *= sc.emit_pmf[j] * fcfg[FCFG_EMIT_SCALE]
+                    j, q = pick_emitter(sc, fcfg, recv, u_group)
+                    idx = n_lamps + max(j, 0)
+                    pmf *= q
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]

@@ -47,12 +47,10 @@ from .closures import (
 from .closures.layout import CL_SW, CL_TERMINATOR, CL_TYPE, CL_W, CT_BSSRDF, CT_DIFFUSE
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
 from .light_sampling import (
-    PMF_EVERY,
     PMF_GLOBAL,
     PMF_LOCAL,
     LightSample,
     emission_weight,
-    group_importance,
     lamps_on_segment,
     sample_light,
     sun_light,
@@ -68,7 +66,6 @@ from .state import (
     CFG_WORLD_CAMERA,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
-    FCFG_EMIT_SCALE,
     FCFG_WORLD_IMPORTANCE,
     FCFG_WORLD_PMF,
     MF_BUMP_CORRECTION,
@@ -315,17 +312,6 @@ def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, 
 
 
 @device
-def emitter_group_scale(sc, fcfg, pmf_mode, mp, mis_total):
-    """Factor from an emissive triangle's scene-wide pick probability (``emit_pmf``)
-    to the probability that next-event estimation at m picked it."""
-    if pmf_mode == PMF_EVERY:
-        return fcfg[FCFG_EMIT_SCALE]
-    if pmf_mode == PMF_LOCAL and mis_total > 0.0:
-        return group_importance(sc.emit_group, mp) / mis_total * fcfg[FCFG_EMIT_SCALE]
-    return 1.0
-
-
-@device
 def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b1, b2, obj, flags,
                  ray_length, depths, dp):
     """The ``ShadingData`` of surface point ``sp`` for a ray of direction d, every field of
@@ -424,9 +410,8 @@ def emission_estimates(sc, scratch, tris, out):
 def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, sp, flags, mis_pdf,
                        pmf_mode, mp, mis_total, direct, er, eg, eb):
     """Add emission (er, eg, eb) of triangle p, seen by the ray at ``sp``, MIS-weighted."""
-    scale = emitter_group_scale(sc, fcfg, pmf_mode, mp, mis_total)
-    w = emission_weight(sc.tri_light, sc.emit_pmf, sp.area, p, t_hit, sp.cos_o, flags,
-                        mis_pdf, scale)
+    w = emission_weight(sc, fcfg, p, sp.area, t_hit, sp.cos_o, flags, mis_pdf, pmf_mode, mp,
+                        mis_total)
     add_light(out, row, beta[i, 0] * er * w, beta[i, 1] * eg * w, beta[i, 2] * eb * w, direct,
               fcfg, stats)
 

@@ -93,7 +93,9 @@ SceneData = namedtuple("SceneData", [
     "emit_tri",      # (NE,) int32  emissive triangle ids
     "emit_pmf",      # (NE,) f64    their NEE probabilities
     "emit_cdf",      # (NE + 1,) f64  distribution over emissive triangles alone
-    "emit_group",    # (5,) f64     emissive triangles as one light: centre, radius^2, scale
+    "emit_group",    # (1, 5) f64   emissive triangles as one light: centre, radius^2, scale
+                     #              (a row of light_tree.sphere_importance)
+    "emit_tree",     # kernels.light_tree.EmitterTree: picks one of them at a point
     "tri_light",     # (T,) int32   index into emit_tri, or -1
     "tri_area",      # (T,) f64
     "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)

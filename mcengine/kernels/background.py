@@ -128,6 +128,8 @@ def sample_world(sc, u1, u2):
         dx, dy, dz, pdf = sample_background(sc.bg_marginal, sc.bg_conditional, u1, u2)
         if pdf <= 0.0:
             return dx, dy, dz, 0.0
+        if share <= 0.0:
+            return dx, dy, dz, pdf          # the map's own: world_pdf would find it again
     return dx, dy, dz, world_pdf(sc, dx, dy, dz)
 
 

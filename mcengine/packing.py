@@ -22,7 +22,7 @@ from .features import detect as detect_plan
 from .images import ImageTable
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
-from .kernels.light_tree import build_emitter_tree, no_tree
+from .kernels.light_tree import S_STRIDE, build_emitter_tree, no_tree, sphere_rows
 from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
 from .kernels.motion import pack_motion
 from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, P_VECTOR, PassData
@@ -139,7 +139,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
-        emit_cdf=np.zeros(1), emit_group=np.zeros((1, 5)), emit_tree=no_tree(),
+        emit_cdf=np.zeros(1), emit_group=np.zeros((1, S_STRIDE)), emit_tree=no_tree(),
         tri_light=np.full(len(tris), -1, np.int32),
         tri_area=tri_area, tri_normal=tri_normal,
         world=shaders.emission[world].copy(), camera=camera,
@@ -189,17 +189,16 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
     if emit_cdf[-1] > 0:
         emit_cdf /= emit_cdf[-1]
-    # The emissive triangles as one light for per-point picking: its centre,
-    # its radius squared (the distance floor) and an irradiance scale.
-    # And the light tree that picks one of them at a point, unless some of them move.
-    emit_group = np.zeros((1, 5))
+    # The emissive triangles as one light for per-point picking (their bounding sphere and
+    # an irradiance scale), and the light tree that picks one of them at a point, unless
+    # some of them move.
+    emit_group = np.zeros((1, S_STRIDE))
     emit_tree = no_tree()
     if len(emit_tri):
         corners = verts[tris[emit_tri]]
-        lo_e, hi_e = corners.reshape(-1, 3).min(axis=0), corners.reshape(-1, 3).max(axis=0)
-        emit_group[0, :3] = 0.5 * (lo_e + hi_e)
-        emit_group[0, 3] = max(0.25 * float(np.sum((hi_e - lo_e) ** 2)), 1e-12)
-        emit_group[0, 4] = emit_power.sum() / math.pi
+        emit_group = sphere_rows(corners.reshape(-1, 3).min(axis=0)[None],
+                                 corners.reshape(-1, 3).max(axis=0)[None],
+                                 np.array([emit_power.sum() / math.pi]))
         slots = sc.motion.tri_slot
         if not (len(slots) and np.any(slots[emit_tri] >= 0)):
             emit_tree = build_emitter_tree(corners, emit_power)

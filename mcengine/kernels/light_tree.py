@@ -51,8 +51,9 @@ def no_tree() -> EmitterTree:
                        np.zeros(0, np.int32))
 
 
-def _spheres(lo, hi, power) -> np.ndarray:
-    """(N, S_STRIDE) rows of the boxes [lo, hi] with their power."""
+def sphere_rows(lo, hi, power) -> np.ndarray:
+    """(N, S_STRIDE) rows of ``sphere_importance``: the spheres around the boxes [lo, hi]
+    (N, 3) with their power (N,); a row without power is all zero."""
     rows = np.zeros((len(lo), S_STRIDE))
     full = power > 0.0
     rows[full, S_CENTRE:S_CENTRE + 3] = 0.5 * (lo[full] + hi[full])
@@ -109,7 +110,7 @@ def build_emitter_tree(corners, power) -> EmitterTree:
         node_hi[k] = np.maximum(node_hi[2 * k + 1], node_hi[2 * k + 2])
         node_power[k] = node_power[2 * k + 1] + node_power[2 * k + 2]
         width //= 2
-    return EmitterTree(_spheres(node_lo, node_hi, node_power), _spheres(lo_t, hi_t, power),
+    return EmitterTree(sphere_rows(node_lo, node_hi, node_power), sphere_rows(lo_t, hi_t, power),
                        order, rank)
 
 

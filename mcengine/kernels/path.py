@@ -356,7 +356,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                     idx = world_light
                 elif idx == n_lamps:
                     j, q = pick_emitter(sc, fcfg, recv, u_group)
-                    idx = n_lamps + max(j, 0)
+                    idx = n_lamps + max(j, 0)       # j = -1 comes with q = 0: no light
                     pmf *= q
             else:
                 idx = pick_light(sc.light_cdf, u_pick)

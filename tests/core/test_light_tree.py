@@ -59,7 +59,7 @@ def test_every_triangle_sits_in_one_leaf_and_every_node_bounds_its_triangles(n):
 
 
 @pytest.mark.parametrize("n", [1, 6, 37, 600])
-def test_picks_follow_the_pmf_and_the_pmf_sums_to_one(n):
+def test_picks_follow_the_pmf_which_sums_to_one_where_no_normal_cuts_it(n):
     """Evenly spaced numbers u pick each triangle in the share of [0, 1) its pmf says (the
     tree maps u to one interval per triangle), tree_pick's pmf is tree_pmf's, and the pmf
     sums to 1 at receivers without a normal; with one it may sum to less: a node's sphere
@@ -90,7 +90,7 @@ def test_picks_follow_the_pmf_and_the_pmf_sums_to_one(n):
         np.testing.assert_allclose(hits / count, pmf, atol=2.0 / count)
 
 
-def test_only_triangles_wholly_behind_the_receiver_are_never_picked():
+def test_no_triangle_reaching_in_front_of_the_receiver_has_pmf_zero():
     corners, power = random_triangles(300, seed=7, size=0.5)
     power[:] = 1.0
     tree = build_emitter_tree(corners, power)

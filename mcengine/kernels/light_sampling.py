@@ -116,8 +116,9 @@ def pick_light(cdf, u):
 @device
 def receiver(hx, hy, hz, nx, ny, nz, cl, ncl):
     """Where next-event estimation picks a light, for the importances' facing term: the point
-    and its shading normal (facing the viewer), or no normal (0, 0, 0) where a closure
-    transmits (Cycles' SD_BSDF_HAS_TRANSMISSION: light from behind counts there too)."""
+    and its shading normal (facing the viewer; the shader's, where a displacement bump moved
+    it: Cycles' sd->N), or no normal (0, 0, 0) where a closure transmits (Cycles'
+    SD_BSDF_HAS_TRANSMISSION: light from behind counts there too)."""
     for k in range(ncl):
         if has_transmission(int(cl[k, CL_TYPE])):
             return hx, hy, hz, 0.0, 0.0, 0.0

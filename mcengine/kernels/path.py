@@ -113,6 +113,7 @@ from .shading import (
     sample_direction,
     set_ray,
     shade_point,
+    shader_normal,
 )
 from .shadows import trace_shadows
 from .state import (
@@ -342,11 +343,13 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                     depths, max_transparent - st.transparent[i])
 
         # -- next-event estimation: one light --------------------------------------------------
-        # Where lights are picked (the point and, on opaque surfaces, its normal); the next ray
-        # keeps it for the MIS weights of the light it finds.
+        # Where lights are picked (the point and, on opaque surfaces, its normal: Cycles' sd->N,
+        # which a displacement bump has moved); the next ray keeps it for the MIS weights of
+        # the light it finds.
         recv = (sp.hx, sp.hy, sp.hz, 0.0, 0.0, 0.0)
         if local:
-            recv = receiver(sp.hx, sp.hy, sp.hz, sp.nsx, sp.nsy, sp.nsz, scratch.cl, ncl)
+            rnx, rny, rnz = shader_normal(sc, scratch.regs, sp)
+            recv = receiver(sp.hx, sp.hy, sp.hz, rnx, rny, rnz, scratch.cl, ncl)
         if nee:
             lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
             if local:

@@ -313,16 +313,16 @@ def filter_table(filter_type: str, width: float, size: int = FILTER_TABLE_SIZE) 
     cdf /= cdf[-1]
     table = np.zeros(size)
     mid = (size - 1) // 2
-    for i in range(mid + 1):
-        target = i / mid
-        k = int(np.searchsorted(cdf, target, side="right"))
-        if k < size - 1:
-            frac = (target - cdf[k]) / (cdf[k + 1] - cdf[k])
-        else:
-            k, frac = size - 1, 0.0
-        y = 2.0 * half * (k + frac) / (size - 1)
-        table[mid + i] = 0.5 * (1.0 + y)
-        table[mid - i] = 0.5 * (1.0 - y)
+    target = np.arange(mid + 1) / mid
+    k = np.searchsorted(cdf, target, side="right")
+    inside = k < size - 1
+    kk = np.where(inside, k, 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        frac = np.where(inside, (target - cdf[kk]) / (cdf[kk + 1] - cdf[kk]), 0.0)
+    k = np.where(inside, k, size - 1)
+    y = 2.0 * half * (k + frac) / (size - 1)
+    table[mid:mid + mid + 1] = 0.5 * (1.0 + y)
+    table[mid::-1] = 0.5 * (1.0 - y)
     return table
 
 

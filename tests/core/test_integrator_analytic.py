@@ -156,6 +156,23 @@ def test_time_limit_and_stop_keep_a_partial_image():
     assert abs(mean - 2.0) < 6 * se + 0.02   # unbiased so far (12 bounces: 2 - 2^-13)
 
 
+
+@pytest.mark.parametrize("res, samples, time_limit, expected", [
+    (16, 64, 0.0, [1, 64]),                       # 16 384 paths: the rest at once
+    (16, 64, 60.0, [1, 2, 4, 8, 16, 32, 64]),     # a time limit keeps the steps
+    (128, 64, 0.0, [1, 2, 4, 8, 16, 32, 64]),     # 1 M paths: progressive
+])
+def test_small_renders_finish_in_one_pass_after_the_first(res, samples, time_limit, expected):
+    """After its first sample per pixel a render whose rest is at most QUICK_FINISH_PATHS
+    paths renders it in one pass (no wait at the end of each of the small passes); larger
+    renders, and renders with a time limit, keep passes of 1, 1, 2, 4, ... samples."""
+    scene = inside_sphere_scene(albedo=0.5, emission=1.0, samples=samples, res=res)
+    scene.integrator.time_limit = time_limit
+    done = []
+    RenderSession(scene).run(on_pass=lambda s: done.append(s.samples_done))
+    assert done == expected
+
+
 def _furnace_sphere(material, samples=8):
     scene = _sky_sphere_scene(0.0, samples=samples)
     scene.materials = [material]

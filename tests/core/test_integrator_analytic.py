@@ -156,7 +156,6 @@ def test_time_limit_and_stop_keep_a_partial_image():
     assert abs(mean - 2.0) < 6 * se + 0.02   # unbiased so far (12 bounces: 2 - 2^-13)
 
 
-
 @pytest.mark.parametrize("res, samples, time_limit, expected", [
     (16, 64, 0.0, [1, 64]),                       # 16 384 paths: the rest at once
     (16, 64, 60.0, [1, 2, 4, 8, 16, 32, 64]),     # a time limit keeps the steps

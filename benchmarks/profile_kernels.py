@@ -74,23 +74,23 @@ def write_perf_map() -> dict:
 def annotate(data: Path, table: dict, name: str, top: int, context: int) -> None:
     """Print the instructions of the compiled function ``name`` (a short name such as
     'path.shade', matched at the end) with the most samples in ``data``."""
-    import ctypes
-
     matches = [(a, s, n) for a, (s, n) in table.items() if short_name(s).endswith(name)]
     if not matches:
         print(f"annotate: no compiled function named {name!r}")
         return
-    address, symbol, size = max(matches, key=lambda m: m[2])
-    counts = collections.Counter()
     script = subprocess.run(["perf", "script", "-i", str(data), "-F", "ip"],
                             capture_output=True, text=True).stdout
     ips = [int(word, 16) for word in script.split()]
+    # A name has several symbols (the function, its CPython wrapper, one per overload): take
+    # the one the samples fall in.
+    address, symbol, size = max(matches, key=lambda m: sum(m[0] <= ip < m[0] + m[2] for ip in ips))
+    counts = collections.Counter()
     for ip in ips:
         if address <= ip < address + size:
             counts[ip] += 1
     inside = sum(counts.values())
     with tempfile.NamedTemporaryFile(suffix=".bin") as code:
-        code.write(ctypes.string_at(address, size))
+        code.write(read_own_memory(address, size))
         code.flush()
         listing = subprocess.run(["objdump", "-D", "-b", "binary", "-m", "i386:x86-64",
                                   "--no-show-raw-insn", f"--adjust-vma={address:#x}", code.name],
@@ -116,6 +116,24 @@ def annotate(data: Path, table: dict, name: str, top: int, context: int) -> None
         for a, insn in rows[max(i - context, 0):i + 1] if i is not None else []:
             mark = f"{counts[a]:5d}" if counts.get(a) else "     "
             print(f"   {mark} +{a - address:#07x}  {insn}")
+
+
+def read_own_memory(address: int, size: int) -> bytes:
+    """Up to ``size`` bytes of this process's memory from ``address``, stopping at the first
+    page that is not mapped (a perf-map size is the gap to the next symbol, which may run past
+    the end of the compiled code; reading it through a pointer crashed the process)."""
+    out = bytearray()
+    with open("/proc/self/mem", "rb", buffering=0) as mem:
+        while len(out) < size:
+            step = min(4096 - (address + len(out)) % 4096, size - len(out))
+            try:
+                chunk = os.pread(mem.fileno(), step, address + len(out))
+            except OSError:
+                break
+            if not chunk:
+                break
+            out += chunk
+    return bytes(out)
 
 
 def short_name(symbol: str) -> str:

@@ -47,8 +47,9 @@ import numpy as np
 
 from . import sky
 from .kernels.camera import CAMERA_PARAMS
-from .kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
+from .kernels.closures.layout import CL_STRIDE, CLOSURE_WEIGHT_CUTOFF, MAX_CLOSURES
 from .kernels.state import (
+    MF_BSSRDF_BUMP,
     MF_BUMP_CORRECTION,
     MF_CLOSURES_ONLY,
     MF_EMISSION_VARIES,
@@ -177,6 +178,7 @@ class Program:
     registers: int = 0                             # registers used
     emission_varies: bool = False                  # some emission input is not constant
     transparency_varies: bool = False              # some transparency input is not constant
+    bssrdf_bump: bool = False                      # a BSSRDF's Normal input is linked
 
     def reg(self, n: int) -> int:
         """Allocate n consecutive registers; returns the first."""
@@ -351,6 +353,21 @@ class _Compiler:
         if any(not v.constant for v in transparency) or (
                 varies and transparency and transparency[0].const != opaque):
             self.program.transparency_varies = True
+        if self.bssrdf_bump(node):
+            self.program.bssrdf_bump = True
+
+    def bssrdf_bump(self, node: ShaderNode) -> bool:
+        """Cycles' has_bssrdf_bump: the node can make a BSSRDF (a Subsurface Scattering node, a
+        Principled BSDF whose Subsurface Weight is linked or above the cutoff) and its Normal
+        input is linked to anything but the Geometry node (shader_nodes.cpp: has_bump)."""
+        if node.type == "BsdfPrincipled":
+            weight = node.inputs.get("Subsurface Weight", 0.0)
+            if not isinstance(weight, Link) and not np.max(weight) > CLOSURE_WEIGHT_CUTOFF:
+                return False
+        elif node.type != "SubsurfaceScattering":
+            return False
+        normal = node.inputs.get("Normal")
+        return isinstance(normal, Link) and self.nodes[normal.node].type != "NewGeometry"
 
     # -- values -----------------------------------------------------------------------------------
     def node(self, link: Link):
@@ -575,7 +592,7 @@ class ShaderTable:
     material emits as a light source, evaluated as Cycles evaluates a light's
     shader (no closures built, so no layer above the emission darkens it;
     facing the normal), and ``flags`` (M,) holds MF_* bits: emissive,
-    transparent to shadow rays, bump-map correction.
+    transparent to shadow rays, bump-map correction, closures only, BSSRDF bump.
     """
 
     def __init__(self, materials, attributes: AttributeLayout | None = None,
@@ -613,6 +630,8 @@ class ShaderTable:
                 flags |= MF_EMISSION_VARIES
             if closures_only(self.ops[self.ranges[i, 0]:self.ranges[i, 1]]):
                 flags |= MF_CLOSURES_ONLY
+            if program.bssrdf_bump:
+                flags |= MF_BSSRDF_BUMP
             if m.use_transparent_shadow and (max(res.tr, res.tg, res.tb) > 0.0
                                              or program.transparency_varies):
                 flags |= MF_TRANSPARENT

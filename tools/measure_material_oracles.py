@@ -86,7 +86,7 @@ def build(bpy, name):
         for key, value in inputs.items():
             sock = node.inputs[key]
             if isinstance(value, tuple) and value and value[0] == "link":
-                tree.links.new(made[value[1]].outputs[0], sock)
+                tree.links.new(made[value[1]].outputs[value[2] if len(value) > 2 else 0], sock)
             elif isinstance(value, tuple):
                 sock.default_value = (*value, 1.0)[:len(sock.default_value)]
             else:

@@ -42,7 +42,6 @@ from .closures.layout import (
     CL_NS,
     CL_RADIUS,
     CL_SSS_ALBEDO,
-    CL_SSS_BUMP,
     CL_SSS_METHOD,
     CL_STRIDE,
     CL_SW,
@@ -134,8 +133,8 @@ from .state import (
     CFG_SUBSURFACE,
     FCFG_FILTER_GLOSSY,
     FCFG_WORLD_IMPORTANCE,
+    MF_BSSRDF_BUMP,
     MF_BUMP_CORRECTION,
-    MF_CLOSURES_ONLY,
     MF_EMISSIVE,
     PF_CAMERA,
     PF_CAUSTIC_EYE,
@@ -468,15 +467,14 @@ def _exit_closure(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, fl
                   footprint):
     """The closure list at a walk's exit (Cycles' subsurface_shader_data_setup): one Lambert
     closure of weight 1 about the smooth normal, or, when a BSSRDF of the material there
-    takes a linked Normal input, about its BSSRDFs' normals averaged by weight (the
-    material's shader runs only then: materials of constant closures have no such input).
+    takes a linked Normal input (MF_BSSRDF_BUMP, Cycles' SD_HAS_BSSRDF_BUMP), about its
+    BSSRDFs' normals averaged by weight: the material's shader runs only then.
     Returns the count, 1."""
     cl = scratch.cl
     nx, ny, nz = sp.nsx, sp.nsy, sp.nsz
-    if not (sc.mat_flags[m] & MF_CLOSURES_ONLY):
+    if sc.mat_flags[m] & MF_BSSRDF_BUMP:
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
                           True, depths, footprint, True)
-        bump = False
         ax = ay = az = 0.0
         for k in range(res.n):
             if cl[k, CL_TYPE] == CT_BSSRDF:
@@ -484,9 +482,8 @@ def _exit_closure(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, fl
                 ax += cl[k, CL_N] * w
                 ay += cl[k, CL_N + 1] * w
                 az += cl[k, CL_N + 2] * w
-                bump = bump or cl[k, CL_SSS_BUMP] != 0.0
         length = math.sqrt(ax * ax + ay * ay + az * az)
-        if bump and length > 0.0:
+        if length > 0.0:
             nx, ny, nz = ax / length, ay / length, az / length
     for c in range(CL_STRIDE):
         cl[0, c] = 0.0

@@ -117,6 +117,8 @@ MF_TRANSPARENT = 2        # has transparent closures and lets shadow rays throug
 MF_BUMP_CORRECTION = 4    # Cycles' use_bump_map_correction
 MF_EMISSION_VARIES = 8    # its emission depends on the point (textures): light samples run its shader
 MF_CLOSURES_ONLY = 16     # its program is closure rows on constant inputs (svm.closures_only)
+MF_BSSRDF_BUMP = 32       # a BSSRDF's Normal is linked: walks' exits run its shader (Cycles'
+                          # SD_HAS_BSSRDF_BUMP; shaders.Program.bssrdf_bump)
 
 # Path flags.
 PF_CAMERA = 1            # no scattering yet: the ray is a camera ray

@@ -17,7 +17,8 @@ import math
 
 # name: (nodes, view_deg, (light_theta_deg, light_azimuth_deg) or None)
 # nodes: list of (type, inputs, props); the last node feeds the Surface socket,
-# inputs of the form ("link", k) take node k's output.
+# inputs of the form ("link", k) take node k's BSDF output, ("link", k, name) its output
+# of that name.
 ORACLES = {
     "principled_defaults": ([("BsdfPrincipled", {}, {})], 0.0, (0.0, 0.0)),
     "principled_white": ([("BsdfPrincipled", {"Base Color": (1, 1, 1)}, {})], 0.0, (0.0, 0.0)),
@@ -129,6 +130,14 @@ SUBSURFACE_ORACLES = {
                                              "Subsurface Scale": 0.02}, {})], 20.0, (180.0, 0.0)),
     "subsurface_burley_slab": ([("SubsurfaceScattering", {"Color": (0.8, 0.5, 0.3), "Scale": 0.02},
                                  {"falloff": "BURLEY"})], 20.0, (180.0, 0.0)),
+    # A linked Normal (an object-space Normal Map tilting it 30 degrees towards the camera,
+    # away from the light) makes Cycles shade the walks' exits about the BSSRDF's normal
+    # (SD_HAS_BSSRDF_BUMP): exits lit at 50 degrees off their normal instead of 20.
+    "subsurface_bump_point": ([("NormalMap", {"Color": (0.75, 0.5, 0.933)}, {"space": "OBJECT"}),
+                               ("BsdfPrincipled", {"Base Color": (0.8, 0.5, 0.3),
+                                                   "Subsurface Weight": 1.0, "Subsurface Scale": 0.2,
+                                                   "Normal": ("link", 0, "Normal")}, {})],
+                              30.0, (20.0, 180.0)),
 }
 ALL_ORACLES = {**ORACLES, **SUBSURFACE_ORACLES}
 SLAB_THICKNESS = {"subsurface_slab": 0.005, "subsurface_burley_slab": 0.005}   # metres

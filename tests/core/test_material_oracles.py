@@ -52,8 +52,9 @@ def oracle_scene(name, samples=16):
     nodes, view, light = ALL_ORACLES[name]
     graph = []
     for kind, inputs, props in nodes:
-        graph.append(ShaderNode(kind, {k: (Link(v[1], "BSDF") if isinstance(v, tuple) and v
-                                           and v[0] == "link" else v) for k, v in inputs.items()},
+        graph.append(ShaderNode(kind, {k: (Link(v[1], v[2] if len(v) > 2 else "BSDF")
+                                           if isinstance(v, tuple) and v and v[0] == "link" else v)
+                                       for k, v in inputs.items()},
                                 dict(props)))
     s = 50.0
     plane = np.array([[[-s, -s, 0], [s, -s, 0], [s, s, 0]], [[-s, -s, 0], [s, s, 0], [-s, s, 0]]])

@@ -39,10 +39,12 @@ from mcengine.kernels.sampling import (
     walk_key,
 )
 from mcengine.kernels.sobol import index_mask
+from mcengine.kernels.state import MF_BSSRDF_BUMP
 from mcengine.kernels.subsurface import build_local_bvh, hg_phase, hg_sample, local_closest, remap
 from mcengine.passes import RenderPasses
-from mcengine.scene import Geometry
+from mcengine.scene import Geometry, Link, Material, ShaderNode
 from mcengine.session import RenderSession
+from mcengine.shaders import ShaderTable
 
 from .expect import Z_LIMIT, render
 from .material_oracles import SUBSURFACE_ORACLES
@@ -252,6 +254,37 @@ def test_the_effects_plan_walks_only_for_subsurface_materials(weight, kinds):
     plan = RenderSession(scene, threads=1).plan
     assert set(plan.lobes) == kinds
     assert plan.subsurface == ("subsurface" in kinds)
+
+
+def _principled(**inputs):
+    return ShaderNode("BsdfPrincipled", {"Subsurface Weight": 1.0, **inputs})
+
+
+_TEXTURE = ShaderNode("TexChecker", {"Scale": 3.0})
+_NORMAL_MAP = ShaderNode("NormalMap", {"Color": (0.75, 0.5, 0.933)}, {"space": "OBJECT"})
+BSSRDF_BUMP = {     # material: whether Cycles sets SD_HAS_BSSRDF_BUMP (exits run the shader)
+    "textured colour": ([_TEXTURE, _principled(**{"Base Color": Link(0, "Color")})], False),
+    "normal map": ([_NORMAL_MAP, _principled(Normal=Link(0, "Normal"))], True),
+    "normal map, no subsurface": ([_NORMAL_MAP, _principled(**{"Normal": Link(0, "Normal"),
+                                                               "Subsurface Weight": 0.0})], False),
+    "normal map, linked weight": ([_NORMAL_MAP, _TEXTURE,
+                                   _principled(**{"Normal": Link(0, "Normal"),
+                                                  "Subsurface Weight": Link(1, "Fac")})], True),
+    "geometry normal": ([ShaderNode("NewGeometry"),
+                         ShaderNode("SubsurfaceScattering", {"Normal": Link(0, "Normal")})], False),
+    "node, normal map": ([_NORMAL_MAP, ShaderNode("SubsurfaceScattering",
+                                                  {"Normal": Link(0, "Normal")})], True),
+}
+
+
+def test_exits_run_the_shader_only_where_a_bssrdf_normal_is_linked():
+    """Cycles evaluates the shader at a walk's exit only for SD_HAS_BSSRDF_BUMP (a node that
+    can make a BSSRDF, its Normal linked to anything but the Geometry node); elsewhere the
+    exit is Lambert about the smooth normal, however textured the material."""
+    table = ShaderTable([Material(nodes=nodes, surface=Link(len(nodes) - 1, "BSDF"))
+                         for nodes, _bump in BSSRDF_BUMP.values()])
+    flagged = {name: bool(f & MF_BSSRDF_BUMP) for name, f in zip(BSSRDF_BUMP, table.flags)}
+    assert flagged == {name: bump for name, (_nodes, bump) in BSSRDF_BUMP.items()}
 
 
 def test_diffuse_color_pass_counts_the_subsurface_closure():

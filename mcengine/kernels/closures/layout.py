@@ -46,20 +46,19 @@ CL_P1 = 31               # sheen LTC a, b)
 CL_P2 = 32
 CL_P3 = 33
 CL_P4 = 34
-CL_ALBEDO = 36           # 3: microfacet: the albedo estimate at the view, from the setup (layering)
-CL_NS = 39               # 3: the point's smooth (interpolated, not normal-mapped) normal, viewer's side
-CL_BUMP_CORRECTION = 42  # 1: the material's Bump Map Correction is on (softens diffuse closures)
-CL_TERMINATOR = 43       # the object's Shadow Terminator Shading Offset as a frequency (> 1: on)
-CL_FILM_THICKNESS = 44   # microfacet: thin film over the surface, thickness in nm (<= 0.1: none)
-CL_FILM_IOR = 45         # microfacet: the film's IOR relative to the outside (tf / IOR on back faces)
-CL_STRIDE = 46
+CL_ALBEDO = 35           # 3: microfacet: the albedo estimate at the view, from the setup (layering)
+CL_NS = 38               # 3: the point's smooth (interpolated, not normal-mapped) normal, viewer's side
+CL_BUMP_CORRECTION = 41  # 1: the material's Bump Map Correction is on (softens diffuse closures)
+CL_TERMINATOR = 42       # the object's Shadow Terminator Shading Offset as a frequency (> 1: on)
+CL_FILM_THICKNESS = 43   # microfacet: thin film over the surface, thickness in nm (<= 0.1: none)
+CL_FILM_IOR = 44         # microfacet: the film's IOR relative to the outside (tf / IOR on back faces)
+CL_STRIDE = 45
 # A BSSRDF row (CT_BSSRDF) keeps its walk's parameters in these columns; its microfacet
 # alpha (the refractive entry's roughness) in CL_AX and its IOR in CL_ETA.
 CL_RADIUS = CL_P0        # 3: mean free path per channel (after Cycles' scaling; 0: no walk)
 CL_SSS_ALBEDO = CL_F0    # 3: the surface albedo the walk reproduces
 CL_ANISOTROPY = CL_P3    # the phase function's g, in [0, 0.9]
 CL_SSS_METHOD = CL_P4    # SSS_* method
-CL_SSS_BUMP = 35         # 1: its normal comes from a linked Normal input (Cycles' SD_HAS_BSSRDF_BUMP)
 CL_VELVET_INV_SIGMA2 = CL_P0   # a velvet's 1 / sigma^2 (sigma = max(roughness, 0.01))
 
 # -- closure types -------------------------------------------------------------------------------

@@ -44,7 +44,6 @@ from ..closures.layout import (
     CL_RADIUS,
     CL_RTINT,
     CL_SSS_ALBEDO,
-    CL_SSS_BUMP,
     CL_SSS_METHOD,
     CL_STRIDE,
     CL_SW,
@@ -202,12 +201,6 @@ def alloc(cl, n, wr, wg, wb, sd):
     cl[n, CL_NS], cl[n, CL_NS + 1], cl[n, CL_NS + 2] = sd.nx, sd.ny, sd.nz
     cl[n, CL_BUMP_CORRECTION] = 1.0 if sd.bump_correction else 0.0
     return n, n + 1
-
-
-@device
-def normal_linked(regs, off):
-    """Whether a Normal input is linked (an unlinked one holds the zero vector)."""
-    return regs[off] != 0.0 or regs[off + 1] != 0.0 or regs[off + 2] != 0.0
 
 
 @device
@@ -413,7 +406,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         n = bssrdf(cl, n, sd, cr, cg, cb, regs[b + SS_RADIUS] * scale,
                    regs[b + SS_RADIUS + 1] * scale, regs[b + SS_RADIUS + 2] * scale,
                    regs[b + COLOR_IN], regs[b + COLOR_IN + 1], regs[b + COLOR_IN + 2],
-                   nx, ny, nz, normal_linked(regs, b + SS_NORMAL), sat(regs[b + SS_ROUGHNESS]),
+                   nx, ny, nz, sat(regs[b + SS_ROUGHNESS]),
                    regs[b + SS_IOR], regs[b + SS_ANISOTROPY], regs[b + SS_FALLOFF])
     elif kind == K_GLOSSY:
         if sd.reflective_caustics:
@@ -437,7 +430,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
 
 
 @function
-def bssrdf(cl, n, sd, wr, wg, wb, rr, rg, rb, ar, ag, ab, nx, ny, nz, bump, alpha, ior,
+def bssrdf(cl, n, sd, wr, wg, wb, rr, rg, rb, ar, ag, ab, nx, ny, nz, alpha, ior,
            anisotropy, method):
     """Append a BSSRDF closure (Cycles' bssrdf_alloc and bssrdf_setup); returns the new count.
 
@@ -478,7 +471,6 @@ def bssrdf(cl, n, sd, wr, wg, wb, rr, rg, rb, ar, ag, ab, nx, ny, nz, bump, alph
         cl[k, CL_ETA] = ior
         cl[k, CL_ANISOTROPY] = min(max(anisotropy, 0.0), 0.9)
         cl[k, CL_SSS_METHOD] = method
-        cl[k, CL_SSS_BUMP] = 1.0 if bump else 0.0
     else:
         cl[k, CL_TYPE] = CT_NONE
         cl[k, CL_W] = cl[k, CL_W + 1] = cl[k, CL_W + 2] = cl[k, CL_SW] = 0.0
@@ -800,7 +792,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
         n = bssrdf(cl, n, sd, cbase_r * subsurface * wr, cbase_g * subsurface * wg,
                    cbase_b * subsurface * wb, regs[o] * scale, regs[o + 1] * scale,
                    regs[o + 2] * scale, cbase_r, cbase_g, cbase_b, rnx, rny, rnz,
-                   normal_linked(regs, b + P_NORMAL), roughness * roughness,
+                   roughness * roughness,
                    regs[b + P_SUBSURFACE_IOR] if method == SSS_RANDOM_WALK_SKIN else eta,
                    regs[b + P_SUBSURFACE_ANISOTROPY], method)
 

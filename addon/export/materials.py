@@ -7,7 +7,7 @@ groups; every node the core evaluates, with its inputs and properties).  On
 top of that, materials translate a few shader nodes the core renders through
 others:
 
-* any other shader node: 0.8 grey diffuse (Cycles' default surface), warned;
+* any other shader node: 0.8 grey diffuse, warned;
 * nothing linked to Surface, or no output: black, as in Cycles;
 * a material without a node tree uses ``diffuse_color``, as Cycles does.
 
@@ -24,9 +24,11 @@ from .shader_graph import GraphReader, label, source
 
 __all__ = ["DEFAULT_SURFACE", "MaterialTable", "convert_material", "linked_node", "clamp_color", "fmt"]
 
-# Cycles' default surface for objects without material and for empty slots.
-DEFAULT_GREY = (0.8, 0.8, 0.8)
-DEFAULT_SURFACE = Material(name="default surface", base_color=DEFAULT_GREY)
+# What objects without material and empty slots render with: in Blender 5.0 Cycles renders
+# them as a default Principled BSDF (measured: the same pixels bit for bit), not as the
+# 0.8 grey diffuse of its own default_surface shader.
+DEFAULT_SURFACE = Material(name="default surface", nodes=[ShaderNode("BsdfPrincipled")],
+                           surface=Link(0, "BSDF"))
 BLACK = (0.0, 0.0, 0.0)
 
 

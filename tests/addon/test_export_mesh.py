@@ -223,7 +223,8 @@ def test_multi_material_mesh_and_material_table(scene, fake_session):
         per_tri[key] = names[g.material_index[t]]
     assert per_tri == {("Multi", 0): "Green", ("Multi", 2): "Red", ("Multi", 4): "default surface",
                        ("Other", 0): "Green", ("Bare", 0): "default surface"}
-    assert desc.materials[names.index("default surface")].base_color == (0.8, 0.8, 0.8)
+    default = desc.materials[names.index("default surface")]     # a default Principled BSDF
+    assert [(n.type, n.inputs) for n in default.nodes] == [("BsdfPrincipled", {})]
 
 
 def test_unit_scale_converts_positions_to_metres(scene, fake_session):

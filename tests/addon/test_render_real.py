@@ -49,3 +49,30 @@ def test_frames_with_the_same_triangles_reuse_the_bvh(scene, addon):
         bpy.ops.render.render()
         reused.append(addon.engine.last_render["stats"].extra["bvh_reused"])
     assert reused[1:] == [True, False, True]
+
+
+def test_objects_without_material_render_as_cycles_renders_them(scene, render_exr):
+    """Blender 5.0's Cycles shades a mesh without material, and an empty slot, as a default
+    Principled BSDF, not as the 0.8 grey diffuse of its own default_surface shader (10 %
+    brighter here).  Under a sun of angle 0 with no bounces, every pixel of an orthographic
+    view of the plane has the same value, so one sample per pixel of each engine gives it;
+    the bound is the material oracles' (float32 tables against float64)."""
+    scene.render.resolution_x, scene.render.resolution_y = 8, 6
+    scene.camera.data.type, scene.camera.data.ortho_scale = "ORTHO", 4.0
+    scene.camera.rotation_euler = (1.2, 0.0, 0.0)     # 69 degrees off the plane's normal
+    scene.camera.location = (0.0, -6.0, 2.0)
+    scene.world = None
+    scene.cycles.samples, scene.cycles.max_bounces = 1, 0
+    scene.cycles.use_adaptive_sampling = False
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy, sun.data.angle = 3.0, 0.0
+    sun.rotation_euler = (0.6, 0.2, 0.5)
+    scene.collection.objects.link(sun)
+    new_mesh_object("Bare", [(-9, -9, -1), (0, -9, -1), (0, 9, -1), (-9, 9, -1)], [(0, 1, 2, 3)])
+    slot = new_mesh_object("Slot", [(0, -9, -1), (9, -9, -1), (9, 9, -1), (0, 9, -1)], [(0, 1, 2, 3)])
+    slot.data.materials.append(None)
+    ours = render_exr()
+    scene.render.engine = "CYCLES"
+    theirs = render_exr()
+    assert theirs[..., 0].std() < 1e-4 * theirs[..., 0].mean()     # the same value everywhere
+    np.testing.assert_allclose(ours, theirs, rtol=2e-3)

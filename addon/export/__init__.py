@@ -166,6 +166,13 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
 
+# Light and shadow linking (Object > Shading > Light Linking / Shadow Linking on a light or an
+# emissive object): the collection each sets, and what MC Engine renders instead.
+_LINKING = {"light linking": "receiver_collection", "shadow linking": "blocker_collection"}
+_LINKING_FALLBACK = {"light linking": "their light reaches every object",
+                     "shadow linking": "every object casts their shadows"}
+
+
 def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = False):
     """One pass over the instances: (geometry, materials, lights, layout); geometry,
     materials and layout (``MeshCollector.layout``, tagged with each instance's motion
@@ -176,10 +183,16 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
     table = materials.MaterialTable(ctx)
     collector = mesh.MeshCollector(ctx, table, depsgraph.view_layer) if meshes else None
     light_list = []
+    linked = {}
     for inst in depsgraph.object_instances:
         if not inst.show_self:
             continue
         ob = inst.object
+        linking = getattr(ob, "light_linking", None)
+        for feature, collection in _LINKING.items():
+            names = linked.setdefault(feature, [])
+            if getattr(linking, collection, None) is not None and _instance_name(inst) not in names:
+                names.append(_instance_name(inst))
         try:
             if ob.type == "LIGHT":
                 light = lights.export_light(ctx, ob, inst.matrix_world.copy(), _instance_name(inst))
@@ -196,6 +209,10 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
                 collector.add(inst, _instance_name(inst), tag)
         except Exception as exc:  # one bad object must not abort the render
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
+    for feature, names in linked.items():
+        if names:
+            ctx.warn(f"{feature} not supported yet ({mesh.listed(names)}); {_LINKING_FALLBACK[feature]}",
+                     feature)
     if collector is None:
         return None, None, light_list, None
     return collector.geometry(), table.materials, light_list, collector.layout

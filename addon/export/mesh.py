@@ -188,10 +188,8 @@ class MeshCollector:
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
         for feature, names in self._noted.items():
-            listed = ", ".join(f"'{n}'" for n in names[:_MAX_LISTED])
-            more = f" and {len(names) - _MAX_LISTED} more" if len(names) > _MAX_LISTED else ""
-            self._ctx.warn(f"{feature} not supported yet ({listed}{more}); "
-                           f"{_OBJECT_NOTES[feature]}", feature)
+            self._ctx.warn(f"{feature} not supported yet ({listed(names)}); {_OBJECT_NOTES[feature]}",
+                           feature)
         parts = [(mesh, np.stack(self._matrices[key]), self._names[key],
                   np.array(self._infos[key], np.float64))
                  for key, mesh in self._meshes.items() if mesh is not None]
@@ -232,6 +230,12 @@ class MeshCollector:
         names = self._noted.setdefault(feature, [])
         if object_name not in names:
             names.append(object_name)
+
+
+def listed(names) -> str:
+    """Object names for a warning: the first few quoted, and how many more."""
+    more = f" and {len(names) - _MAX_LISTED} more" if len(names) > _MAX_LISTED else ""
+    return ", ".join(f"'{n}'" for n in names[:_MAX_LISTED]) + more
 
 
 def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | None:

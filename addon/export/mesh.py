@@ -55,6 +55,7 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "shadow catcher": "these objects render as normal objects",
+    "indirect only collections": "these objects are also seen directly",
     SPHERE_SEAM: "their normal maps' tangents near it (object space x = 0, y < 0) may differ "
                  "from Cycles' (elsewhere they agree)",
 }
@@ -130,7 +131,7 @@ class MeshCollector:
         self._ctx = ctx
         self._materials = materials
         self._view_layer = view_layer
-        self._holdouts: dict[int, bool] = {}      # by original object: one question each
+        self._layer_flags: dict = {}              # by (question, original object): asked once
         self._meshes: dict[tuple, LocalMesh | None] = {}
         self._matrices: dict[tuple, list] = {}
         self._names: dict[tuple, list] = {}
@@ -164,6 +165,8 @@ class MeshCollector:
             self._note("ray visibility", ob.name)
         if getattr(ob, "is_shadow_catcher", False):
             self._note("shadow catcher", ob.name)
+        if self._indirect_only(inst):
+            self._note("indirect only collections", ob.name)
         slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
@@ -214,17 +217,27 @@ class MeshCollector:
         """Whether the instance is a holdout: its object's (an instance's: its instancer's)
         own setting or its collection's in the view layer (Cycles' blender/object.cpp asks the
         same of Blender; the original object and view layer answer, evaluated ones do not)."""
+        return self._layer_flag(inst, "holdout_get", "is_holdout")
+
+    def _indirect_only(self, inst) -> bool:
+        """Whether the instance's collection is Indirect Only in the view layer (for Cycles
+        only where it is not a holdout)."""
+        return not self._holdout(inst) and self._layer_flag(inst, "indirect_only_get", None)
+
+    def _layer_flag(self, inst, question: str, own: str | None) -> bool:
+        """The view layer's answer to ``Object.<question>`` for the instance's object (an
+        instance's: its instancer's); where it is not in the view layer, its own flag ``own``."""
         ob = (inst.parent if inst.is_instance else inst.object).original
-        key = ob.as_pointer()
-        if key not in self._holdouts:
-            held = None
+        key = (question, ob.as_pointer())
+        if key not in self._layer_flags:
+            answer = None
             if self._view_layer is not None:
                 try:
-                    held = bool(ob.holdout_get(view_layer=self._view_layer))
-                except RuntimeError:  # not in the view layer (Blender reports it): its own flag
+                    answer = bool(getattr(ob, question)(view_layer=self._view_layer))
+                except RuntimeError:  # not in the view layer (Blender reports it)
                     pass
-            self._holdouts[key] = bool(getattr(ob, "is_holdout", False)) if held is None else held
-        return self._holdouts[key]
+            self._layer_flags[key] = bool(own and getattr(ob, own, False)) if answer is None else answer
+        return self._layer_flags[key]
 
     def _note(self, feature: str, object_name: str) -> None:
         names = self._noted.setdefault(feature, [])

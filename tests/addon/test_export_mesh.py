@@ -318,6 +318,22 @@ def test_holdout_objects_and_collections_are_exported(scene, fake_session):
         "shadow catcher not supported yet ('Catcher'); these objects render as normal objects"]
 
 
+def test_indirect_only_collections_are_named(scene, fake_session):
+    """A collection set Indirect Only in the view layer (not rendered: its objects are seen
+    directly) is named in a warning with its objects; a holdout collection that is also
+    Indirect Only is a holdout, as in Cycles, and not named."""
+    for name, holdout in (("Bounce", False), ("Masked", True)):
+        col = bpy.data.collections.new(name)
+        scene.collection.children.link(col)
+        new_mesh_object(f"In{name}", TRI, [(0, 1, 2)], collection=col)
+        layer = bpy.context.view_layer.layer_collection.children[name]
+        layer.indirect_only, layer.holdout = True, holdout
+    new_mesh_object("Plain", TRI, [(0, 1, 2)])
+    desc = export_scene(fake_session)
+    assert [w for w in desc.warnings if "indirect only" in w] == [
+        "indirect only collections not supported yet ('InBounce'); these objects are also seen directly"]
+
+
 def _attribute_grid(n=6):
     """A smooth n x n grid with two UV maps (the second renders), a byte colour per corner,
     a float colour per point and a float per face read by its material's Attribute node;

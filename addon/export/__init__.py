@@ -222,13 +222,13 @@ def _materials_in_order(ctx, depsgraph) -> list:
     """The material table as the walk would build it, without reading any mesh."""
     import bpy
 
-    from . import materials
+    from . import materials, mesh
     table = materials.MaterialTable(ctx)
     for inst in depsgraph.object_instances:
         ob = inst.object
         if inst.show_self and ob.type != "LIGHT" and isinstance(ob.data, bpy.types.Mesh):
-            for slot in ob.material_slots:
-                table.index(slot.material)
+            for material in mesh.slot_materials(ob, depsgraph.view_layer.material_override):
+                table.index(material)
     return table.materials
 
 

@@ -131,6 +131,7 @@ class MeshCollector:
         self._ctx = ctx
         self._materials = materials
         self._view_layer = view_layer
+        self._override = getattr(view_layer, "material_override", None)
         self._layer_flags: dict = {}              # by (question, original object): asked once
         self._meshes: dict[tuple, LocalMesh | None] = {}
         self._matrices: dict[tuple, list] = {}
@@ -167,7 +168,7 @@ class MeshCollector:
             self._note("shadow catcher", ob.name)
         if self._indirect_only(inst):
             self._note("indirect only collections", ob.name)
-        slots = tuple(self._materials.index(s.material) for s in ob.material_slots)
+        slots = tuple(self._materials.index(m) for m in slot_materials(ob, self._override))
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
             self._meshes[key] = read_local_mesh(ob, slots, self._materials.attribute_names(),
@@ -243,6 +244,15 @@ class MeshCollector:
         names = self._noted.setdefault(feature, [])
         if object_name not in names:
             names.append(object_name)
+
+
+def slot_materials(ob, override=None) -> list:
+    """The Blender materials of an object's slots (None: an empty slot), as Cycles reads them
+    (blender/mesh.cpp, find_used_shaders): with the view layer's Material Override, that
+    material in every slot, and in one slot for an object without any."""
+    if override is not None:
+        return [override] * max(len(ob.material_slots), 1)
+    return [s.material for s in ob.material_slots]
 
 
 def listed(names) -> str:

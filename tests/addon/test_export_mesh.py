@@ -227,6 +227,20 @@ def test_multi_material_mesh_and_material_table(scene, fake_session):
     assert [(n.type, n.inputs) for n in default.nodes] == [("BsdfPrincipled", {})]
 
 
+def test_material_override_replaces_every_slot(scene, fake_session):
+    """View Layer > Material Override: every slot of every mesh, empty ones and objects
+    without slots included, renders with that material (Cycles' find_used_shaders)."""
+    red, green, clay = (bpy.data.materials.new(n) for n in ("Red", "Green", "Clay"))
+    ob = new_mesh_object("Multi", TRI, [(0, 1, 2)], materials=[red, green])
+    ob.data.materials.append(None)
+    new_mesh_object("Bare", TRI, [(0, 1, 2)]).location = (0, 9, 0)
+    bpy.context.view_layer.material_override = clay
+    desc = export_scene(fake_session)
+    names = [m.name for m in desc.materials]
+    assert {names[i] for i in desc.geometry.material_index} == {"Clay"}
+    assert "Red" not in names and "Green" not in names
+
+
 def test_unit_scale_converts_positions_to_metres(scene, fake_session):
     scene.unit_settings.scale_length = 0.01
     ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])

@@ -76,6 +76,7 @@ from ..closures.sheen import sheen_setup
 from ..closures.thin_film import THIN_FILM_CUTOFF
 from ..sampling import orthonormal_basis
 from ..state import PF_DIFFUSE_ANCESTOR
+from .math_nodes import rotate_around_axis
 from .nodes import (
     COLOR_IN,
     D_NORMAL,
@@ -227,16 +228,6 @@ def set_frame(cl, k, nx, ny, nz, tx, ty, tz):
     else:
         xx, xy, xz, _bx, _by, _bz = orthonormal_basis(nx, ny, nz)
     cl[k, CL_T], cl[k, CL_T + 1], cl[k, CL_T + 2] = xx, xy, xz
-
-
-@device
-def rotate_around_axis(px, py, pz, ax, ay, az, angle):
-    """p rotated by ``angle`` about the unit axis a (right-handed)."""
-    c, s = math.cos(angle), math.sin(angle)
-    d = (px * ax + py * ay + pz * az) * (1.0 - c)
-    return (px * c + (ay * pz - az * py) * s + ax * d,
-            py * c + (az * px - ax * pz) * s + ay * d,
-            pz * c + (ax * py - ay * px) * s + az * d)
 
 
 @device

@@ -486,3 +486,13 @@ def map_range_vector(regs, b, out):
             lo, hi = (tmax, tmin) if tmin > tmax else (tmin, tmax)
             result = min(max(result, lo), hi)
         regs[out + k] = result
+
+
+@device
+def rotate_around_axis(px, py, pz, ax, ay, az, angle):
+    """p rotated by ``angle`` about the unit axis a (right-handed)."""
+    c, s = math.cos(angle), math.sin(angle)
+    d = (px * ax + py * ay + pz * az) * (1.0 - c)
+    return (px * c + (ay * pz - az * py) * s + ax * d,
+            py * c + (az * px - ax * pz) * s + ay * d,
+            pz * c + (ax * py - ay * px) * s + az * d)

@@ -166,6 +166,11 @@ COLOR_MODES = {"RGB": 0, "HSV": 1, "HSL": 2}
 # ``vector_type``: Mapping (all four), Vector Transform (POINT, VECTOR, NORMAL).
 VECTOR_TYPES = {"POINT": 0, "TEXTURE": 1, "VECTOR": 2, "NORMAL": 3}
 
+# Vector Rotate's ``rotation_type``.
+ROTATE_AXIS_ANGLE, ROTATE_X, ROTATE_Y, ROTATE_Z, ROTATE_EULER_XYZ = 0, 1, 2, 3, 4
+ROTATE_TYPES = {"AXIS_ANGLE": ROTATE_AXIS_ANGLE, "X_AXIS": ROTATE_X, "Y_AXIS": ROTATE_Y,
+                "Z_AXIS": ROTATE_Z, "EULER_XYZ": ROTATE_EULER_XYZ}
+
 # Vector Transform's ``convert_from`` and ``convert_to``.
 TRANSFORM_SPACES = {"WORLD": 0, "OBJECT": 1, "CAMERA": 2}
 
@@ -207,6 +212,7 @@ ENUMS = {
     "clamp_type": CLAMP_TYPES,
     "mode": COLOR_MODES,
     "vector_type": VECTOR_TYPES,
+    "rotation_type": ROTATE_TYPES,
     "noise_dimensions": DIMENSIONS,
     "noise_type": NOISE_TYPES,
     "voronoi_dimensions": DIMENSIONS,
@@ -498,6 +504,11 @@ VALUE_NODES = {
     # -- vector family (svm/vector_nodes.py)
     "Mapping": NodeSpec(501, (_v("Vector"), _v("Location"), _v("Rotation"), _v("Scale", WHITE),
                               _p("vector_type", VECTOR_TYPES["POINT"])), (_v("Vector"),), True),
+    "VectorRotate": NodeSpec(503, (_v("Vector", (0.0, 0.0, 0.0)), _v("Center", (0.0, 0.0, 0.0)),
+                                   _v("Axis", (0.0, 0.0, 1.0)), _f("Angle", 0.0),
+                                   _v("Rotation", (0.0, 0.0, 0.0)),
+                                   _p("rotation_type", ROTATE_AXIS_ANGLE), _p("invert", 0)),
+                             (_v("Vector"),), True),
     "VectorTransform": NodeSpec(502, (_v("Vector", (0.5, 0.5, 0.5)),
                                       _p("vector_type", VECTOR_TYPES["VECTOR"]),
                                       _p("convert_from", TRANSFORM_SPACES["WORLD"]),

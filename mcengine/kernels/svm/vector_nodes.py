@@ -1,5 +1,5 @@
-"""Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h) and Vector Transform
-(kernel/svm/vector_transform.h).
+"""Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h), Vector Rotate
+(kernel/svm/vector_rotate.h) and Vector Transform (kernel/svm/vector_transform.h).
 
 ``eval_vector_node`` evaluates one node of the family: inputs at regs[b:] in
 the order of ``nodes.VALUE_NODES``, outputs to regs[c:].
@@ -19,10 +19,26 @@ from .input_nodes import (
     transform_direction,
     transform_point,
 )
-from .math_nodes import safe_divide, safe_normalize
-from .nodes import NODES, OFFSETS, TRANSFORM_SPACES, VECTOR_TYPES
+from .math_nodes import rotate_around_axis, safe_divide, safe_normalize
+from .nodes import (
+    NODES,
+    OFFSETS,
+    ROTATE_EULER_XYZ,
+    ROTATE_X,
+    ROTATE_Y,
+    ROTATE_Z,
+    TRANSFORM_SPACES,
+    VECTOR_TYPES,
+)
 
 _MAPPING = NODES["Mapping"].code
+_VECTOR_ROTATE = NODES["VectorRotate"].code
+_VR_CENTER = OFFSETS["VectorRotate"]["Center"]
+_VR_AXIS = OFFSETS["VectorRotate"]["Axis"]
+_VR_ANGLE = OFFSETS["VectorRotate"]["Angle"]
+_VR_ROTATION = OFFSETS["VectorRotate"]["Rotation"]
+_VR_TYPE = OFFSETS["VectorRotate"]["prop:rotation_type"]
+_VR_INVERT = OFFSETS["VectorRotate"]["prop:invert"]
 _VECTOR_TRANSFORM = NODES["VectorTransform"].code
 _VT_TYPE = OFFSETS["VectorTransform"]["prop:vector_type"]
 _VT_FROM = OFFSETS["VectorTransform"]["prop:convert_from"]
@@ -44,6 +60,8 @@ _NORMAL = VECTOR_TYPES["NORMAL"]
 def eval_vector_node(code, regs, b, c, sd, tex):
     if code == _MAPPING:
         mapping_node(regs, b, c)
+    elif code == _VECTOR_ROTATE:
+        vector_rotate(regs, b, c)
     elif code == _VECTOR_TRANSFORM:
         vector_transform(regs, b, c, sd, tex)
 
@@ -87,6 +105,48 @@ def mapping_node(regs, b, c):
         elif kind == _NORMAL:
             x, y, z = safe_normalize(x, y, z)
     regs[c], regs[c + 1], regs[c + 2] = x, y, z
+
+
+@device
+def vector_rotate(regs, b, c):
+    """Vector Rotate about Center: by Euler XYZ angles (inverted: the transposed rotation), or
+    by Angle about X, Y, Z or Axis (inverted: by -Angle); a zero Axis leaves the vector as it
+    is (svm_node_vector_rotate)."""
+    kind = int(regs[b + _VR_TYPE])
+    invert = regs[b + _VR_INVERT] != 0.0
+    o = b + _VR_CENTER
+    cx, cy, cz = regs[o], regs[o + 1], regs[o + 2]
+    vx, vy, vz = regs[b] - cx, regs[b + 1] - cy, regs[b + 2] - cz
+    if kind == ROTATE_EULER_XYZ:
+        o = b + _VR_ROTATION
+        r0, r1, r2 = euler_rotation(regs[o], regs[o + 1], regs[o + 2])
+        if invert:
+            x = r0[0] * vx + r1[0] * vy + r2[0] * vz
+            y = r0[1] * vx + r1[1] * vy + r2[1] * vz
+            z = r0[2] * vx + r1[2] * vy + r2[2] * vz
+        else:
+            x = r0[0] * vx + r0[1] * vy + r0[2] * vz
+            y = r1[0] * vx + r1[1] * vy + r1[2] * vz
+            z = r2[0] * vx + r2[1] * vy + r2[2] * vz
+        regs[c], regs[c + 1], regs[c + 2] = x + cx, y + cy, z + cz
+        return
+    if kind == ROTATE_X:
+        ax, ay, az = 1.0, 0.0, 0.0
+    elif kind == ROTATE_Y:
+        ax, ay, az = 0.0, 1.0, 0.0
+    elif kind == ROTATE_Z:
+        ax, ay, az = 0.0, 0.0, 1.0
+    else:
+        o = b + _VR_AXIS
+        ax, ay, az = regs[o], regs[o + 1], regs[o + 2]
+    length = math.sqrt(ax * ax + ay * ay + az * az)
+    if length == 0.0:
+        regs[c], regs[c + 1], regs[c + 2] = regs[b], regs[b + 1], regs[b + 2]
+        return
+    angle = regs[b + _VR_ANGLE]
+    x, y, z = rotate_around_axis(vx, vy, vz, ax / length, ay / length, az / length,
+                                 -angle if invert else angle)
+    regs[c], regs[c + 1], regs[c + 2] = x + cx, y + cy, z + cz
 
 
 @device

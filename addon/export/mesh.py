@@ -55,6 +55,7 @@ _OBJECT_NOTES = {
     "volume objects": "these objects are skipped",
     "ray visibility": "these objects are visible to all rays",
     "shadow catcher": "these objects render as normal objects",
+    "particle hair": "their strands are not rendered",
     "indirect only collections": "these objects are also seen directly",
     SPHERE_SEAM: "their normal maps' tangents near it (object space x = 0, y < 0) may differ "
                  "from Cycles' (elsewhere they agree)",
@@ -166,6 +167,8 @@ class MeshCollector:
             self._note("ray visibility", ob.name)
         if getattr(ob, "is_shadow_catcher", False):
             self._note("shadow catcher", ob.name)
+        if any(ps.settings.render_type == "PATH" for ps in getattr(ob, "particle_systems", ())):
+            self._note("particle hair", ob.name)
         if self._indirect_only(inst):
             self._note("indirect only collections", ob.name)
         slots = tuple(self._materials.index(m) for m in slot_materials(ob, self._override))

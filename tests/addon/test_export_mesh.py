@@ -304,6 +304,20 @@ def test_each_objects_shadow_terminator_offsets_are_exported(scene, fake_session
     assert not [w for w in desc.warnings if "terminator" in w]
 
 
+def test_particle_hair_is_named(scene, fake_session):
+    """A particle system rendered as strands (Render As: Path, what Cycles draws as hair) is
+    named in a warning; one rendered as objects is not (its instances are exported)."""
+    furry = new_mesh_object("Furry", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+    dotted = new_mesh_object("Dotted", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
+    for ob, render_type in ((furry, "PATH"), (dotted, "NONE")):
+        ob.modifiers.new("Particles", "PARTICLE_SYSTEM")
+        settings = ob.particle_systems[0].settings
+        settings.type, settings.count, settings.render_type = "HAIR", 10, render_type
+    desc = export_scene(fake_session)
+    assert [w for w in desc.warnings if "particle" in w] == [
+        "particle hair not supported yet ('Furry'); their strands are not rendered"]
+
+
 def test_holdout_objects_and_collections_are_exported(scene, fake_session):
     """Object > Visibility > Holdout, a collection's Holdout in the view layer (for its own
     objects and for a collection instance of it: the instancer decides, as in Cycles); the

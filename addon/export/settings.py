@@ -77,6 +77,14 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
     if getattr(cycles, "use_fast_gi", False):
         ctx.warn("Fast GI Approximation is not supported; rendering full global illumination",
                  "Fast GI")
+    if getattr(cycles, "texture_limit_render", "OFF") != "OFF":
+        ctx.warn(f"Texture Limit ({cycles.texture_limit_render} px) is not supported; images are "
+                 "read at full size", "texture limit")
+    culled = [kind for kind in ("camera", "distance") if getattr(cycles, f"use_{kind}_cull", False)
+              and any(getattr(ob.cycles, f"use_{kind}_cull", False) for ob in scene.objects)]
+    if culled:
+        ctx.warn(f"{' and '.join(culled).capitalize()} Culling is not supported; the culled objects "
+                 "are rendered", "culling")
     samples = int(cycles.samples)
     if cycles.use_layer_samples == "USE" and view_layer.samples > 0:
         samples = int(view_layer.samples)  # Cycles' per-view-layer sample override

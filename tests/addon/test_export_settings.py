@@ -3,7 +3,7 @@ import addon_utils
 import bpy
 import pytest
 
-from .helpers import export_scene
+from .helpers import export_scene, new_mesh_object
 
 
 def test_integrator_reads_cycles_settings(scene, fake_session):
@@ -58,6 +58,18 @@ def test_fast_gi_is_warned(scene, fake_session):
     scene.cycles.use_fast_gi = True
     assert export_scene(fake_session).warnings == [
         "Fast GI Approximation is not supported; rendering full global illumination"]
+
+
+def test_texture_limit_and_culling_are_warned(scene, fake_session):
+    """Texture Limit and camera culling change what Cycles renders; each is warned.  Culling
+    only where an object has it on: the scene's switch alone culls nothing."""
+    scene.cycles.use_camera_cull = scene.cycles.use_distance_cull = True
+    assert export_scene(fake_session).warnings == []
+    scene.cycles.texture_limit_render = "1024"
+    new_mesh_object("Far", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)]).cycles.use_camera_cull = True
+    assert export_scene(fake_session).warnings == [
+        "Texture Limit (1024 px) is not supported; images are read at full size",
+        "Camera Culling is not supported; the culled objects are rendered"]
 
 
 def test_view_layer_samples_override(scene, fake_session):

@@ -69,6 +69,18 @@ def render_seed(cycles, scene) -> int:
     return hashed
 
 
+def _uses_shadow_caustics(scene) -> bool:
+    """Whether Cycles renders shadow caustics (manifold next-event estimation) in the scene:
+    it needs a light, a caster and a receiver with their Shadow Caustics switches on."""
+    light = caster = receiver = False
+    for ob in scene.objects:
+        settings = getattr(ob, "cycles", None)
+        light = light or (ob.type == "LIGHT" and getattr(ob.data.cycles, "is_caustics_light", False))
+        caster = caster or getattr(settings, "is_caustics_caster", False)
+        receiver = receiver or getattr(settings, "is_caustics_receiver", False)
+    return light and caster and receiver
+
+
 def export_integrator(ctx, scene, view_layer) -> Integrator:
     """Sampling and path settings from ``scene.cycles``; warns about what is not supported."""
     cycles = cycles_settings(ctx, scene)
@@ -85,6 +97,9 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
     if culled:
         ctx.warn(f"{' and '.join(culled).capitalize()} Culling is not supported; the culled objects "
                  "are rendered", "culling")
+    if _uses_shadow_caustics(scene):
+        ctx.warn("Shadow Caustics are not supported yet; those caustics are left to path tracing "
+                 "(a few bright samples, not Cycles' focused light)", "shadow caustics")
     samples = int(cycles.samples)
     if cycles.use_layer_samples == "USE" and view_layer.samples > 0:
         samples = int(view_layer.samples)  # Cycles' per-view-layer sample override

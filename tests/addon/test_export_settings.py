@@ -72,6 +72,19 @@ def test_texture_limit_and_culling_are_warned(scene, fake_session):
         "Camera Culling is not supported; the culled objects are rendered"]
 
 
+def test_shadow_caustics_are_warned_with_a_light_a_caster_and_a_receiver(scene, fake_session):
+    light = bpy.data.objects.new("Key", bpy.data.lights.new("Key", "POINT"))
+    scene.collection.objects.link(light)
+    light.data.cycles.is_caustics_light = True
+    glass = new_mesh_object("Glass", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
+    glass.cycles.is_caustics_caster = True
+    assert export_scene(fake_session).warnings == []      # no receiver: Cycles has no MNEE
+    glass.cycles.is_caustics_receiver = True
+    assert export_scene(fake_session).warnings == [
+        "Shadow Caustics are not supported yet; those caustics are left to path tracing "
+        "(a few bright samples, not Cycles' focused light)"]
+
+
 def test_view_layer_samples_override(scene, fake_session):
     scene.cycles.samples = 64
     bpy.context.view_layer.samples = 5

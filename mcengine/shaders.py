@@ -362,7 +362,7 @@ class _Compiler:
         input is linked to anything but the Geometry node (shader_nodes.cpp: has_bump)."""
         if node.type == "BsdfPrincipled":
             weight = node.inputs.get("Subsurface Weight", 0.0)
-            if not isinstance(weight, Link) and not np.max(weight) > CLOSURE_WEIGHT_CUTOFF:
+            if not isinstance(weight, Link) and not float(weight) > CLOSURE_WEIGHT_CUTOFF:
                 return False
         elif node.type != "SubsurfaceScattering":
             return False

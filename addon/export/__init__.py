@@ -168,9 +168,8 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
 
 # Light and shadow linking (Object > Shading > Light Linking / Shadow Linking on a light or an
 # emissive object): the collection each sets, and what MC Engine renders instead.
-_LINKING = {"light linking": "receiver_collection", "shadow linking": "blocker_collection"}
-_LINKING_FALLBACK = {"light linking": "their light reaches every object",
-                     "shadow linking": "every object casts their shadows"}
+_LINKING = {"light linking": ("receiver_collection", "their light reaches every object"),
+            "shadow linking": ("blocker_collection", "every object casts their shadows")}
 
 
 def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = False):
@@ -189,7 +188,7 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
             continue
         ob = inst.object
         linking = getattr(ob, "light_linking", None)
-        for feature, collection in _LINKING.items():
+        for feature, (collection, _fallback) in _LINKING.items():
             names = linked.setdefault(feature, [])
             if getattr(linking, collection, None) is not None and _instance_name(inst) not in names:
                 names.append(_instance_name(inst))
@@ -211,8 +210,7 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
     for feature, names in linked.items():
         if names:
-            ctx.warn(f"{feature} not supported yet ({mesh.listed(names)}); {_LINKING_FALLBACK[feature]}",
-                     feature)
+            ctx.warn(f"{feature} not supported yet ({mesh.listed(names)}); {_LINKING[feature][1]}", feature)
     if collector is None:
         return None, None, light_list, None
     return collector.geometry(), table.materials, light_list, collector.layout

@@ -19,7 +19,7 @@ debug information, so the listing is machine code, not source lines).
 
 Run: python benchmarks/profile_kernels.py [--scene FILE.blend] [--materials file|principled|textured]
                                           [--samples N] [--resolution N] [--renders K] [--top T]
-                                          [--annotate NAME [--context C]]
+                                          [--annotate NAME [--context C] [--listing FILE]]
 """
 from __future__ import annotations
 
@@ -71,7 +71,8 @@ def write_perf_map() -> dict:
     return table
 
 
-def annotate(data: Path, table: dict, name: str, top: int, context: int) -> None:
+def annotate(data: Path, table: dict, name: str, top: int, context: int,
+             listing_path: str | None = None) -> None:
     """Print the instructions of the compiled function ``name`` (a short name such as
     'path.shade', matched at the end) with the most samples in ``data``."""
     matches = [(a, s, n) for a, (s, n) in table.items() if short_name(s).endswith(name)]
@@ -116,6 +117,11 @@ def annotate(data: Path, table: dict, name: str, top: int, context: int) -> None
         for a, insn in rows[max(i - context, 0):i + 1] if i is not None else []:
             mark = f"{counts[a]:5d}" if counts.get(a) else "     "
             print(f"   {mark} +{a - address:#07x}  {insn}")
+    if listing_path:
+        with open(listing_path, "w") as out:
+            for a, insn in rows:
+                mark = f"{counts[a]:5d}" if counts.get(a) else "     "
+                out.write(f"   {mark} +{a - address:#07x}  {insn}\n")
 
 
 def read_own_memory(address: int, size: int) -> bytes:
@@ -166,6 +172,9 @@ def main(argv=None) -> int:
                     help="also show the hottest instructions of this compiled function")
     ap.add_argument("--context", type=int, default=6,
                     help="instructions shown before each hot one (with --annotate)")
+    ap.add_argument("--listing", metavar="FILE",
+                    help="write the annotated function's whole listing, samples per "
+                         "instruction, to FILE (with --annotate)")
     args = ap.parse_args(argv)
     if args.materials is None:
         args.materials = "principled" if args.scene == bench_cornell.SCENE else "file"
@@ -207,7 +216,7 @@ def main(argv=None) -> int:
                                  "-g", "none", "--sort", "dso,sym", "--field-separator", "|"],
                                 capture_output=True, text=True).stdout
         if args.annotate:
-            annotate(data, table, args.annotate, args.top, args.context)
+            annotate(data, table, args.annotate, args.top, args.context, args.listing)
     shares = collections.Counter()
     for line in report.splitlines():
         fields = line.split("|")

@@ -57,6 +57,7 @@ SCENES = (
     "world_sky",
     "material_displacement",
     "material_subsurface",
+    "ray_visibility",
 )
 
 

@@ -4,7 +4,7 @@ Frames of an animation in which only the camera, the lights, the materials or
 the world change, and the viewport's restarts after a view or material edit,
 render the same triangles again: they reuse the Embree BVH of the previous
 render instead of building it anew.  The triangles are recognised by a hash
-of the vertex and index arrays (BLAKE2b, about 1 ms per MB, far below the
+of the vertex and index arrays and their ray visibility (BLAKE2b, about 1 ms per MB, far below the
 cost of a build).  One BVH is kept, the last one built; it is dropped before
 a different one is built, so at most one extra BVH stays in memory.  A scene
 with objects moving during the shutter is never reused nor kept: its moving
@@ -25,9 +25,10 @@ _lock = threading.Lock()
 _last: tuple[bytes, Accel] | None = None
 
 
-def _digest(vertices: np.ndarray, triangles: np.ndarray) -> bytes:
+def _digest(vertices: np.ndarray, triangles: np.ndarray, visibility) -> bytes:
     h = hashlib.blake2b(digest_size=32)
-    for array, dtype in ((vertices, np.float32), (triangles, np.int32)):
+    visibility = np.zeros(0) if visibility is None else visibility
+    for array, dtype in ((vertices, np.float32), (triangles, np.int32), (visibility, np.uint32)):
         array = np.ascontiguousarray(array, dtype)
         h.update(repr(array.shape).encode())
         if array.size:          # (a view of no bytes cannot be cast)
@@ -35,20 +36,21 @@ def _digest(vertices: np.ndarray, triangles: np.ndarray) -> bytes:
     return h.digest()
 
 
-def accel_for(vertices, triangles, motion=None) -> tuple[Accel, bool]:
+def accel_for(vertices, triangles, motion=None, visibility=None) -> tuple[Accel, bool]:
     """A BVH of these triangles (with the moving ones of ``motion``, a
-    ``kernels.motion.MotionData``) and whether it was reused (True) or built (False)."""
+    ``kernels.motion.MotionData``; each triangle's ray ``visibility``, ``Accel``'s) and
+    whether it was reused (True) or built (False)."""
     global _last
     if motion is not None and len(motion.tri_slot):
         with _lock:
             _last = None           # free the old BVH; this one is not kept
-        return Accel(vertices, triangles, motion), False
-    key = _digest(vertices, triangles)
+        return Accel(vertices, triangles, motion, visibility=visibility), False
+    key = _digest(vertices, triangles, visibility)
     with _lock:
         if _last is not None and _last[0] == key:
             return _last[1], True
         _last = None               # free the old BVH before building the new one
-        accel = Accel(vertices, triangles)
+        accel = Accel(vertices, triangles, visibility=visibility)
         _last = (key, accel)
         return accel, False
 

@@ -59,6 +59,11 @@ from .kernels.state import (
     FCFG_WORLD_PMF,
     MF_EMISSION_VARIES,
     MF_EMISSIVE,
+    VIS_ALL,
+    VIS_DIFFUSE,
+    VIS_GLOSSY,
+    VIS_SCATTER,
+    VIS_TRANSMISSION,
     SceneData,
     alloc_scratch,
 )
@@ -75,6 +80,7 @@ from .kernels.svm import (
     OBJ_TERMINATOR_SHADING,
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
+    OBJ_VISIBILITY,
     OP_NODE,
     TextureData,
 )
@@ -171,6 +177,12 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     # Lights: lamps, and the triangles of emissive materials.
     if len(tris):
         emissive = ((shaders.flags[mat_index] & MF_EMISSIVE) != 0) & (tri_area > 0.0)
+        # An emissive object that no diffuse, glossy, transmission or volume scatter ray sees
+        # is no light (Cycles' Object::usable_as_light); the lobes the others do not see are
+        # excluded from its light samples (light_sampling.emitter_exclude).
+        visibility = g.triangle_visibility()
+        if visibility is not None:
+            emissive &= (visibility & (VIS_DIFFUSE | VIS_GLOSSY | VIS_TRANSMISSION | VIS_SCATTER)) != 0
     else:
         emissive = np.zeros(0, bool)
     emit_tri = np.flatnonzero(emissive).astype(np.int32)
@@ -298,6 +310,8 @@ def pack_objects(g) -> np.ndarray:
         out[:o, OBJ_PASS_INDEX] = info[:, 1]
         out[:o, OBJ_COLOR:OBJ_COLOR + 4] = info[:, 2:6]
     out[:o, OBJ_HOLDOUT] = [1.0 if info.holdout else 0.0 for info in g.object_pass_info()]
+    out[:, OBJ_VISIBILITY] = VIS_ALL
+    out[:o, OBJ_VISIBILITY] = g.visibility()
     terminator = g.terminator_offsets() if o else np.array([DEFAULT_TERMINATOR_OFFSETS])
     out[:, OBJ_TERMINATOR_GEOMETRY] = terminator[:, 0]
     # Cycles keeps the Shading Offset s as the frequency of its shift_cos_in (scene/object.cpp).

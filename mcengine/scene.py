@@ -29,6 +29,7 @@ import numpy as np
 
 from . import integrators, memory, samplers
 from .denoise import Denoising
+from .kernels.state import VIS_ALL
 from .passes import RenderPasses
 
 __all__ = [
@@ -98,6 +99,9 @@ class Geometry:
                     each in [0, 1] (``DEFAULT_TERMINATOR_OFFSETS`` when absent)
     object_passes   per entry of ``object_names``, its :class:`ObjectPassInfo` (render passes, holdout;
                     empty: each object is named by its ``object_names`` entry)
+    object_visibility (O,) uint8    Ray Visibility: the rays that see the object, ``VIS_*`` bits
+                    (``kernels.state``: camera, diffuse, glossy, transmission, shadow, volume
+                    scatter; absent: every ray)
     """
 
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
@@ -113,6 +117,7 @@ class Geometry:
     object_info: np.ndarray | None = None
     object_terminator: np.ndarray | None = None
     object_passes: list = field(default_factory=list)
+    object_visibility: np.ndarray | None = None
 
     @property
     def num_objects(self) -> int:
@@ -147,6 +152,20 @@ class Geometry:
         if self.object_terminator is not None:
             return np.asarray(self.object_terminator, np.float64)
         return np.tile(DEFAULT_TERMINATOR_OFFSETS, (self.num_objects, 1))
+
+    def visibility(self) -> np.ndarray:
+        """(O,) uint8: each object's ray visibility, the default (every ray) filled in."""
+        if self.object_visibility is not None:
+            return np.asarray(self.object_visibility, np.uint8)
+        return np.full(self.num_objects, VIS_ALL, np.uint8)
+
+    def triangle_visibility(self) -> np.ndarray | None:
+        """(T,) uint8: the ray visibility of each triangle's object; None when every object
+        is visible to every ray."""
+        visibility = self.visibility()
+        if np.all(visibility == VIS_ALL) or not self.num_triangles:
+            return None
+        return visibility[np.clip(self.object_index, 0, len(visibility) - 1)]
 
     def object_pass_info(self) -> list:
         """An :class:`ObjectPassInfo` per entry of ``object_names``."""
@@ -223,7 +242,9 @@ class Geometry:
             object_texspace=np.concatenate([o[1] for o in objects]),
             object_info=np.concatenate([o[2] for o in objects]),
             object_terminator=np.concatenate([g.terminator_offsets() for g in parts]),
-            object_passes=infos)
+            object_passes=infos,
+            object_visibility=(None if all(g.object_visibility is None for g in parts)
+                               else np.concatenate([g.visibility() for g in parts])))
 
 
 def auto_texspace_size(texspace: np.ndarray) -> np.ndarray:
@@ -639,6 +660,11 @@ class SceneDescription:
                 continue
             if np.shape(a) != shape or not np.all(np.isfinite(a)):
                 raise SceneError(f"geometry.{name} must be finite with shape {shape}")
+        if g.object_visibility is not None and (
+                np.shape(g.object_visibility) != (o,)
+                or np.any((np.asarray(g.object_visibility, np.int64) & ~VIS_ALL) != 0)):
+            raise SceneError(f"geometry.object_visibility must hold ({o},) masks of VIS_* bits "
+                             f"(0..{VIS_ALL})")
         if g.object_terminator is not None and not np.all(
                 (np.asarray(g.object_terminator) >= 0.0) & (np.asarray(g.object_terminator) <= 1.0)):
             raise SceneError("geometry.object_terminator: the Shadow Terminator offsets must lie "
@@ -789,7 +815,8 @@ class SceneDescription:
             path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
             object_matrix=matrix, object_texspace=texspace, object_info=info,
-            object_terminator=g.terminator_offsets(), **attributes,
+            object_terminator=g.terminator_offsets(), object_visibility=g.visibility(),
+            **attributes,
             **images, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
 
     @staticmethod
@@ -826,7 +853,8 @@ _SAVED_ARRAYS = {
     "meta": ("u", ()),
 }
 _OPTIONAL_ARRAYS = {"object_matrix": ("f", (4, 4)), "object_texspace": ("f", (2, 3)),
-                    "object_info": ("f", (6,)), "object_terminator": ("f", (2,))}
+                    "object_info": ("f", (6,)), "object_terminator": ("f", (2,)),
+                    "object_visibility": ("iu", ())}
 MAX_META_BYTES = 64 << 20
 
 
@@ -875,6 +903,7 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
                     attributes={str(name): z[f"attribute{k}"] for k, name in enumerate(names)},
                     object_matrix=z.get("object_matrix"), object_texspace=z.get("object_texspace"),
                     object_info=z.get("object_info"), object_terminator=z.get("object_terminator"),
+                    object_visibility=z.get("object_visibility"),
                     object_passes=[ObjectPassInfo(**o) for o in meta.get("object_passes", [])])
     lights = []
     for d in meta["lights"]:

@@ -190,16 +190,17 @@ class _TimedAccel:
     def __init__(self, accel, clock):
         self._accel = accel
         self._clock = clock
+        self.masked = accel.masked
 
-    def closest(self, o, d, t, times=None):
+    def closest(self, o, d, t, times=None, mask=None):
         t0 = time.perf_counter()
-        r = self._accel.closest(o, d, t, times)
+        r = self._accel.closest(o, d, t, times, mask)
         self._clock[0] += time.perf_counter() - t0
         return r
 
-    def occluded(self, o, d, t, times=None):
+    def occluded(self, o, d, t, times=None, mask=None):
         t0 = time.perf_counter()
-        r = self._accel.occluded(o, d, t, times)
+        r = self._accel.occluded(o, d, t, times, mask)
         self._clock[0] += time.perf_counter() - t0
         return r
 
@@ -351,8 +352,10 @@ class RenderSession:
         self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
         self.accel, self.stats.extra["bvh_reused"] = accel_cache.accel_for(
-            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion)
+            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion,
+            scene.geometry.triangle_visibility())
         self.stats.time_bvh = time.perf_counter() - t0
+        self._warn_ray_visibility(scene)
         t0 = time.perf_counter()
         self._warm_up()
         self.stats.time_kernels = time.perf_counter() - t0
@@ -361,6 +364,22 @@ class RenderSession:
         self._all_workers = []
         self._buffer_bytes = 0
         self._lock = threading.Lock()
+
+    def _warn_ray_visibility(self, scene) -> None:
+        """Name where objects' Ray Visibility is not honoured (every ray sees them there)."""
+        if scene.geometry.triangle_visibility() is None:
+            return
+        if not self.accel.masked:
+            self.warnings.append("Ray Visibility needs Embree's library, which was not found "
+                                 "(embreex's own API has no ray masks): every object is seen "
+                                 "by every ray")
+        elif self._classic:
+            self.warnings.append(f"{self.integrator.name} does not honour objects' Ray "
+                                 f"Visibility: every object is seen by every ray; Path Tracing "
+                                 f"honours it as Cycles")
+        elif self.light_tables is not None:
+            self.warnings.append("light tracing's paths see every object whatever its Ray "
+                                 "Visibility (the camera paths honour it)")
 
     # -- public ------------------------------------------------------------------------
     @property

@@ -33,6 +33,7 @@ import numpy as np
 
 from . import integrators, jit
 from .denoise import Denoising
+from .kernels.state import VIS_ALL, VIS_CAMERA
 from .scene import (
     Camera,
     Film,
@@ -103,7 +104,8 @@ def features_scene() -> SceneDescription:
     integrator (``tests/core/test_warm_up_scene.py`` checks each runs): a world whose
     radiance varies (its importance map is baked, ``kernels.background``), a square that
     emits a gradient (a mesh light whose emission varies: ``kernels.shading.emission_estimates``
-    weighs it) and moves while the shutter is open (motion blur: ``kernels.motion``), above
+    weighs it) and moves while the shutter is open (motion blur: ``kernels.motion``) hidden
+    from the camera (rays with visibility masks: ``kernels.intersect.ray_masks``), above
     the warm-up's floor, which a texture displaces (``kernels.displace``)."""
     lamp = _FLOOR[:, ::-1] * 0.2 + (0.0, 0.0, 1.0)         # facing down
     gradient = [ShaderNode("TexGradient")]
@@ -115,9 +117,11 @@ def features_scene() -> SceneDescription:
     steps[:, 0, 3] = (-0.1, 0.0, 0.1)
     camera = np.eye(4)
     camera[2, 3] = 0.5
+    geometry = Geometry.from_triangles(np.concatenate([_FLOOR, lamp]), material_index=[0, 0, 1, 1],
+                                       object_index=[0, 0, 1, 1], object_names=["floor", "lamp"])
+    geometry.object_visibility = np.array([VIS_ALL, VIS_ALL & ~VIS_CAMERA], np.uint8)
     return SceneDescription(
-        geometry=Geometry.from_triangles(np.concatenate([_FLOOR, lamp]), material_index=[0, 0, 1, 1],
-                                         object_index=[0, 0, 1, 1], object_names=["floor", "lamp"]),
+        geometry=geometry,
         materials=[_displaced_material(), emission], world=world,
         motion_blur=MotionBlur(objects=[ObjectMotion(object=1, vertices=(6, 6), matrices=steps)]),
         camera=Camera(matrix_world=camera), film=Film(width=1, height=1),

@@ -27,6 +27,14 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from mcengine.kernels.state import (
+    VIS_CAMERA,
+    VIS_DIFFUSE,
+    VIS_GLOSSY,
+    VIS_SCATTER,
+    VIS_SHADOW,
+    VIS_TRANSMISSION,
+)
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
@@ -53,15 +61,14 @@ _OBJECT_NOTES = {
     "hair curves": "these objects are skipped",
     "point clouds": "these objects are skipped",
     "volume objects": "these objects are skipped",
-    "ray visibility": "these objects are visible to all rays",
     "shadow catcher": "these objects render as normal objects",
     "particle hair": "their strands are not rendered",
-    "indirect only collections": "these objects are also seen directly",
     SPHERE_SEAM: "their normal maps' tangents near it (object space x = 0, y < 0) may differ "
                  "from Cycles' (elsewhere they agree)",
 }
-# Object.visible_* flags Cycles uses for meshes.
-_RAYS = ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")
+# Object.visible_* flags and the rays they let see the object (Cycles' object_ray_visibility).
+_RAYS = {"camera": VIS_CAMERA, "diffuse": VIS_DIFFUSE, "glossy": VIS_GLOSSY,
+         "transmission": VIS_TRANSMISSION, "volume_scatter": VIS_SCATTER, "shadow": VIS_SHADOW}
 # Object names listed in one warning line; the rest are counted.
 _MAX_LISTED = 5
 # Swapping corners 1 and 2 reverses a triangle's winding.
@@ -141,6 +148,7 @@ class MeshCollector:
         self._passes: dict[tuple, list] = {}
         self._tags: dict[tuple, list] = {}
         self._terminators: dict[tuple, list] = {}
+        self._visibility: dict[tuple, list] = {}
         # Per geometry object, after geometry(): (tag, (first vertex, count), LocalMesh, slots, matrix).
         self.layout: list = []
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
@@ -163,14 +171,10 @@ class MeshCollector:
             return
         if not isinstance(ob.data, bpy.types.Mesh):
             return
-        if any(not getattr(ob, f"visible_{ray}", True) for ray in _RAYS):
-            self._note("ray visibility", ob.name)
         if getattr(ob, "is_shadow_catcher", False):
             self._note("shadow catcher", ob.name)
         if any(ps.settings.render_type == "PATH" for ps in getattr(ob, "particle_systems", ())):
             self._note("particle hair", ob.name)
-        if self._indirect_only(inst):
-            self._note("indirect only collections", ob.name)
         slots = tuple(self._materials.index(m) for m in slot_materials(ob, self._override))
         key = (ob.data.as_pointer(), slots)
         if key not in self._meshes:
@@ -181,6 +185,7 @@ class MeshCollector:
                 self._note(mesh.tangents_failed, ob.name)
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
             self._passes[key], self._tags[key], self._terminators[key] = [], [], []
+            self._visibility[key] = []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
@@ -191,6 +196,7 @@ class MeshCollector:
             self._tags[key].append(tag)
             self._terminators[key].append((ob.shadow_terminator_geometry_offset,
                                            ob.shadow_terminator_shading_offset))
+            self._visibility[key].append(self._ray_visibility(inst))
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -206,6 +212,9 @@ class MeshCollector:
         geometry.object_terminator = np.array(
             [t for key, mesh in self._meshes.items() if mesh is not None
              for t in self._terminators[key]], np.float64).reshape(-1, 2)
+        geometry.object_visibility = np.array(
+            [v for key, mesh in self._meshes.items() if mesh is not None
+             for v in self._visibility[key]], np.uint8)
         # The instances' places in the geometry, in the order _place_all writes them.
         self.layout = []
         first = 0
@@ -222,6 +231,17 @@ class MeshCollector:
         own setting or its collection's in the view layer (Cycles' blender/object.cpp asks the
         same of Blender; the original object and view layer answer, evaluated ones do not)."""
         return self._layer_flag(inst, "holdout_get", "is_holdout")
+
+    def _ray_visibility(self, inst) -> int:
+        """The rays that see the instance (``VIS_*`` bits; Cycles' blender/object.cpp): its
+        object's Ray Visibility, an instance's also its instancer's, and not camera rays in
+        an Indirect Only collection."""
+        visibility = object_ray_visibility(inst.object)
+        if inst.is_instance and inst.parent is not None:
+            visibility &= object_ray_visibility(inst.parent)
+        if self._indirect_only(inst):
+            visibility &= ~VIS_CAMERA
+        return visibility
 
     def _indirect_only(self, inst) -> bool:
         """Whether the instance's collection is Indirect Only in the view layer (for Cycles
@@ -247,6 +267,11 @@ class MeshCollector:
         names = self._noted.setdefault(feature, [])
         if object_name not in names:
             names.append(object_name)
+
+
+def object_ray_visibility(ob) -> int:
+    """An object's Object > Visibility > Ray Visibility switches as ``VIS_*`` bits."""
+    return sum(bit for ray, bit in _RAYS.items() if getattr(ob, f"visible_{ray}", True))
 
 
 def slot_materials(ob, override=None) -> list:

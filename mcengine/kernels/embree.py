@@ -70,6 +70,7 @@ class _Library:
             "rtcNewGeometry": (vp, [vp, ctypes.c_int]),
             "rtcSetSharedGeometryBuffer": (None, [vp, ctypes.c_int, ctypes.c_uint, ctypes.c_int, vp,
                                                   ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t]),
+            "rtcSetGeometryMask": (None, [vp, ctypes.c_uint]),
             "rtcCommitGeometry": (None, [vp]),
             "rtcAttachGeometry": (ctypes.c_uint, [vp, vp]),
             "rtcReleaseGeometry": (None, [vp]),
@@ -122,16 +123,19 @@ def _load() -> _Library | None:
         return _library
 
 
-def build(vertices, triangles, packets: bool = True):
+def build(vertices, triangles, packets: bool = True, masks=None):
     """A committed Embree scene of these triangles, with ``closest`` and ``occluded``.
 
     vertices : (V, 3) float32-convertible; triangles : (T, 3) int, T > 0.
-    ``packets=False`` (or no library found) uses embreex's single-ray API.
+    ``masks`` : (T,) uint32, optional: each triangle's visibility mask; a ray (whose own
+    mask the queries take) passes through the triangles whose mask shares no bit with its.
+    ``packets=False`` (or no library found) uses embreex's single-ray API, which has no
+    masks: every triangle is then visible to every ray (``masked`` is False).
     """
     library = _load() if packets else None
     if library is None:
         return _EmbreexScene(vertices, triangles)
-    return _PacketScene(library, vertices, triangles)
+    return _PacketScene(library, vertices, triangles, masks)
 
 
 def build_local(vertices, triangles):
@@ -153,26 +157,46 @@ def build_local(vertices, triangles):
 class _PacketScene:
     """The scene built through the library's C API: ``closest`` and ``occluded`` trace in
     packets from compiled code; compiled code may also trace its handle (``_scene``) one ray
-    at a time (:func:`intersect_one`)."""
+    at a time (:func:`intersect_one`).
 
-    def __init__(self, library: _Library, vertices, triangles):
+    With visibility masks the triangles are grouped by mask, one Embree geometry per group
+    (Embree's masks are per geometry); a hit's primitive id is then mapped back from its
+    geometry's to the caller's numbering."""
+
+    def __init__(self, library: _Library, vertices, triangles, masks=None):
         lib = library.lib
         self._library = library
         vertices = np.asarray(vertices, np.float32)
         # Embree reads vertex buffers 16 bytes at a time: one float3 of padding at the end.
         self._vertices = np.zeros((len(vertices) + 1, 3), np.float32)
         self._vertices[:-1] = vertices
+        self.masked = masks is not None
+        if self.masked:
+            masks = np.asarray(masks, np.uint32)
+            order = np.argsort(masks, kind="stable").astype(np.int32)
+            groups, self._first = np.unique(masks[order], return_index=True)
+            self._ids = order
+            triangles = np.asarray(triangles)[order]
+        else:
+            groups = [np.uint32(_INVALID_ID)]
+            self._first = np.zeros(1, np.int64)
+            self._ids = np.zeros(0, np.int32)
+        self._first = self._first.astype(np.int32)
         self._triangles = np.ascontiguousarray(triangles, np.uint32)
         self._scene = lib.rtcNewScene(library.device)
         lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST)
-        geometry = lib.rtcNewGeometry(library.device, _GEOMETRY_TYPE_TRIANGLE)
-        lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3,
-                                       self._vertices.ctypes.data, 0, 12, len(vertices))
-        lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3,
-                                       self._triangles.ctypes.data, 0, 12, len(self._triangles))
-        lib.rtcCommitGeometry(geometry)
-        lib.rtcAttachGeometry(self._scene, geometry)
-        lib.rtcReleaseGeometry(geometry)
+        ends = [*self._first[1:], len(self._triangles)]
+        for mask, first, end in zip(groups, self._first, ends):
+            geometry = lib.rtcNewGeometry(library.device, _GEOMETRY_TYPE_TRIANGLE)
+            lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3,
+                                           self._vertices.ctypes.data, 0, 12, len(vertices))
+            lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3,
+                                           self._triangles[first:].ctypes.data, 0, 12,
+                                           int(end - first))
+            lib.rtcSetGeometryMask(geometry, int(mask))
+            lib.rtcCommitGeometry(geometry)
+            lib.rtcAttachGeometry(self._scene, geometry)     # ids 0, 1, ... in this order
+            lib.rtcReleaseGeometry(geometry)
         lib.rtcCommitScene(self._scene)
         error = lib.rtcGetDeviceError(library.device)
         if error:
@@ -183,17 +207,17 @@ class _PacketScene:
         if scene:
             self._library.lib.rtcReleaseScene(scene)
 
-    def closest(self, origins, directions, tfar):
+    def closest(self, origins, directions, tfar, mask=None):
         prim = np.empty(origins.shape[0], np.int32)
-        self._trace(self._library.intersect, origins, directions, tfar, prim, False)
+        self._trace(self._library.intersect, origins, directions, tfar, prim, False, mask)
         return prim
 
-    def occluded(self, origins, directions, tfar):
+    def occluded(self, origins, directions, tfar, mask=None):
         blocked = np.empty(origins.shape[0], np.int32)
-        self._trace(self._library.occluded, origins, directions, tfar, blocked, True)
+        self._trace(self._library.occluded, origins, directions, tfar, blocked, True, mask)
         return blocked != 0
 
-    def _trace(self, fn, origins, directions, tfar, out, occlusion):
+    def _trace(self, fn, origins, directions, tfar, out, occlusion, mask):
         raw = np.empty(_ROWS * PACKET * 4 + PACKET * 4 + 2 * _ALIGN, np.uint8)
         start = -raw.ctypes.data % _ALIGN
         packet = raw[start:start + _ROWS * PACKET * 4].view(np.float32)
@@ -202,11 +226,25 @@ class _PacketScene:
         trace_packets(fn, self._scene, np.ascontiguousarray(origins, np.float32),
                       np.ascontiguousarray(directions, np.float32),
                       np.ascontiguousarray(tfar, np.float32), out, occlusion,
-                      packet, packet.view(np.uint32), valid)
+                      packet, packet.view(np.uint32), valid, _ray_masks(mask), self._first,
+                      self._ids)
+
+
+def _ray_masks(mask):
+    """A query's ray masks for trace_packets: none (every ray sees everything), one for all
+    rays, or one per ray."""
+    if mask is None:
+        return _NO_MASKS
+    return np.atleast_1d(np.asarray(mask, np.uint32))
+
+
+_NO_MASKS = np.zeros(0, np.uint32)
 
 
 class _EmbreexScene:
-    """The scene through embreex's Python API: single rays in its C loop."""
+    """The scene through embreex's Python API: single rays in its C loop (no masks)."""
+
+    masked = False
 
     def __init__(self, vertices, triangles):
         from embreex import rtcore_scene
@@ -218,10 +256,10 @@ class _EmbreexScene:
         # threads at once.
         self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
 
-    def closest(self, origins, directions, tfar):
+    def closest(self, origins, directions, tfar, mask=None):
         return self._scene.run(origins, directions, dists=tfar, query="INTERSECT")
 
-    def occluded(self, origins, directions, tfar):
+    def occluded(self, origins, directions, tfar, mask=None):
         return self._scene.run(origins, directions, dists=tfar, query="OCCLUDED") != -1
 
 
@@ -243,15 +281,20 @@ def _call_packet(typingctx, fn, valid, scene, rays):
 
 
 @kernel
-def trace_packets(fn, scene, o, d, tfar, out, occlusion, packet, packet_u, valid):
+def trace_packets(fn, scene, o, d, tfar, out, occlusion, packet, packet_u, valid, mask, first,
+                  ids):
     """Trace rays (o, d, (0, tfar)) PACKET at a time through ``fn``.
 
     Closest hits: out = primitive id or -1.  Occlusion: out = 1 where blocked, else 0.
     ``packet`` / ``packet_u`` are one _ROWS x PACKET buffer aligned to _ALIGN bytes, seen
-    as float32 and uint32; ``valid`` PACKET int32 aligned likewise.
+    as float32 and uint32; ``valid`` PACKET int32 aligned likewise.  ``mask``: the rays'
+    visibility masks (none: all bits; one: every ray's; else one per ray); ``first``: each
+    geometry's first triangle in the order ``ids`` maps to the caller's ids (none: the
+    caller's order).
     """
     w = PACKET
     n = o.shape[0]
+    masks = mask.shape[0]
     for s in range(0, n, w):
         m = min(w, n - s)
         for k in range(w):
@@ -263,7 +306,10 @@ def trace_packets(fn, scene, o, d, tfar, out, occlusion, packet, packet_u, valid
             packet[_TNEAR * w + k] = 0.0
             packet[_TIME * w + k] = 0.0
             packet[_TFAR * w + k] = tfar[i]
-            packet_u[_MASK * w + k] = _INVALID_ID
+            if masks == 0:
+                packet_u[_MASK * w + k] = _INVALID_ID
+            else:
+                packet_u[_MASK * w + k] = mask[i] if masks > 1 else mask[0]
             packet_u[_ID * w + k] = 0
             packet_u[_FLAGS * w + k] = 0
             packet_u[_PRIM_ID * w + k] = _INVALID_ID
@@ -275,8 +321,12 @@ def trace_packets(fn, scene, o, d, tfar, out, occlusion, packet, packet_u, valid
                 out[s + k] = 1 if packet[_TFAR * w + k] < 0.0 else 0
         else:
             for k in range(m):
-                hit = packet_u[_GEOM_ID * w + k] != _INVALID_ID
-                out[s + k] = np.int32(packet_u[_PRIM_ID * w + k]) if hit else -1
+                geom = packet_u[_GEOM_ID * w + k]
+                if geom == _INVALID_ID:
+                    out[s + k] = -1
+                else:
+                    q = first[geom] + np.int32(packet_u[_PRIM_ID * w + k])
+                    out[s + k] = ids[q] if ids.shape[0] else q
 
 
 _RAY_HIT_WORDS = 24     # RTCRayHit: 12 words of ray, 8 of hit, spare for instPrimID, padding

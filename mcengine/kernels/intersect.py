@@ -18,6 +18,11 @@ How the renderer lives with Embree's float32 rays:
   rounding, as triangles are flat) is detected by primitive id and traced
   again from just past that hit (``Accel.closest`` callers do this).
 
+Objects hidden from some rays (Object > Visibility > Ray Visibility) are passed through by
+those rays: each triangle has a visibility mask (``state.VIS_*`` bits) and each query the
+mask of its rays (:func:`ray_visibility` of the path's flags, ``VIS_SHADOW`` for shadow
+rays), as Cycles' BVH skips the objects whose visibility shares no bit with the ray's.
+
 The Embree scene has no motion blur (no time on rays, no motion BVH).  Objects that
 move while the shutter is open (``kernels.motion``) are left out of the
 Embree scene and intersected exactly at each ray's time by the motion
@@ -32,6 +37,18 @@ import numpy as np
 from ..jit import device, kernel
 from . import embree
 from .motion import moving_closest, moving_normals, moving_occluded, moving_triangle
+from .state import (
+    PF_CAMERA,
+    PF_DIFFUSE,
+    PF_GLOSSY,
+    PF_SUBSURFACE,
+    PF_TRANSMIT,
+    VIS_ALL,
+    VIS_CAMERA,
+    VIS_DIFFUSE,
+    VIS_GLOSSY,
+    VIS_TRANSMISSION,
+)
 
 # Relative origin offset: 2^-18 of the largest coordinate magnitude is about
 # 32 float32 ulps, above the rounding of the origin to float32 (half an ulp
@@ -58,32 +75,50 @@ class Accel:
         The moving objects; their triangles are intersected at each ray's time.
     packets : bool
         Trace in Embree's packets (``kernels.embree``); False: embreex's single rays.
+    visibility : (T,) integer, optional
+        Each triangle's ray visibility (``VIS_*`` bits; absent: visible to every ray).
+
+    ``masked`` is True when some triangle is hidden from some rays: the callers then pass
+    their rays' masks to the queries (``mask``: one for every ray, or one per ray).
     """
 
-    def __init__(self, vertices, triangles, motion=None, packets=True):
+    def __init__(self, vertices, triangles, motion=None, packets=True, visibility=None):
         self.num_triangles = int(len(triangles))
         self._scene = None
         self._motion = motion if motion is not None and len(motion.tri_slot) else None
         self._static_ids = None
+        if visibility is not None and np.all(np.asarray(visibility) & VIS_ALL == VIS_ALL):
+            visibility = None
+        self._slot_masks = _NO_MASKS
+        if visibility is not None:
+            visibility = np.asarray(visibility, np.uint32) & VIS_ALL
         if self._motion is not None:
             self._static_ids = np.flatnonzero(self._motion.tri_slot < 0).astype(np.int32)
             self._verts = np.asarray(vertices, np.float64)
             self._tris = np.ascontiguousarray(triangles, np.int32)
             triangles = np.asarray(triangles)[self._static_ids]
+            if visibility is not None:     # a moving object's triangles share its visibility
+                slots = self._motion.tri_slot
+                self._slot_masks = np.full(self._motion.slot_info.shape[0], VIS_ALL, np.uint32)
+                self._slot_masks[slots[slots >= 0]] = visibility[slots >= 0]
+                visibility = visibility[self._static_ids]
         if len(triangles):
-            self._scene = embree.build(vertices, triangles, packets)
+            self._scene = embree.build(vertices, triangles, packets, visibility)
+        self.masked = visibility is not None and (self._scene is None or self._scene.masked)
 
-    def closest(self, origins, directions, tfar, time=None):
+    def closest(self, origins, directions, tfar, time=None, mask=None):
         """Primitive id of the closest hit within (0, tfar), or -1.
 
         origins, directions : (n, 3) float32; tfar : (n,) float32; time : (n,)
-        float64 in [0, 1] over the shutter (only moving objects look at it).
+        float64 in [0, 1] over the shutter (only moving objects look at it); mask: the rays'
+        visibility (``VIS_*`` bits: one int for all, or (n,) per ray; absent: every bit).
         """
         n = origins.shape[0]
+        mask = mask if self.masked else None
         if self._scene is None or n == 0:
             prim = np.full(n, -1, np.int32)
         else:
-            prim = self._scene.closest(origins, directions, tfar)
+            prim = self._scene.closest(origins, directions, tfar, mask)
         if self._motion is None or n == 0:
             return prim
         if self._scene is not None:
@@ -91,20 +126,58 @@ class Accel:
         best = np.empty(n)
         hit_distances(self._verts, self._tris, origins, directions, tfar, prim, best)
         moving_closest(self._motion, self._verts, self._tris, origins, directions,
-                       _times(time, n), best, prim)
+                       _times(time, n), best, prim, self._slot_masks, _masks(mask))
         return prim
 
-    def occluded(self, origins, directions, tfar, time=None):
-        """True where something blocks the segment (0, tfar) (at the ray's time)."""
+    def occluded(self, origins, directions, tfar, time=None, mask=None):
+        """True where something the rays see (``mask``, as for ``closest``) blocks the
+        segment (0, tfar) (at the ray's time)."""
         n = origins.shape[0]
+        mask = mask if self.masked else None
         if self._scene is None or n == 0:
             blocked = np.zeros(n, np.bool_)
         else:
-            blocked = self._scene.occluded(origins, directions, tfar)
+            blocked = self._scene.occluded(origins, directions, tfar, mask)
         if self._motion is not None and n:
             moving_occluded(self._motion, self._verts, self._tris, origins, directions, tfar,
-                            _times(time, n), blocked)
+                            _times(time, n), blocked, self._slot_masks, _masks(mask))
         return blocked
+
+
+_NO_MASKS = np.zeros(0, np.uint32)
+
+
+def _masks(mask):
+    return _NO_MASKS if mask is None else np.atleast_1d(np.asarray(mask, np.uint32))
+
+
+@device
+def ray_visibility(flags):
+    """The visibility mask of a ray of a path with these PF_* flags (Cycles'
+    path_state_ray_visibility): camera rays, until the path scatters (transparent surfaces
+    passed keep it one); transmission rays see the objects visible to transmission only;
+    reflected rays those visible to their lobe (diffuse or glossy, singular included).  The
+    ray that brings a subsurface walk to its exit triangle (Cycles finds the exit with a
+    local query, which has no visibility) sees everything."""
+    if flags & PF_SUBSURFACE:
+        return VIS_ALL
+    if flags & PF_CAMERA:
+        return VIS_CAMERA
+    if flags & PF_TRANSMIT:
+        return VIS_TRANSMISSION
+    vis = 0
+    if flags & PF_DIFFUSE:
+        vis |= VIS_DIFFUSE
+    if flags & PF_GLOSSY:
+        vis |= VIS_GLOSSY
+    return vis
+
+
+@kernel
+def ray_masks(flags, out):
+    """out[i] = ray_visibility(flags[i]) (uint32)."""
+    for i in range(out.shape[0]):
+        out[i] = ray_visibility(flags[i])
 
 
 def _times(time, n):

@@ -59,7 +59,11 @@ from .state import (
     PF_MIS_SKIP,
     PF_REFLECT,
     PF_TRANSMIT,
+    VIS_DIFFUSE,
+    VIS_GLOSSY,
+    VIS_TRANSMISSION,
 )
+from .svm import OBJ_VISIBILITY
 
 # How a light's selection probability is known, for MIS weights.
 PMF_GLOBAL = 0            # by power, scene-wide (lamps[:, L_PMF], emit_pmf)
@@ -164,6 +168,22 @@ def nee_exclude(lamp_flags):
     if not (lamp_flags & LF_VIS_GLOSSY):
         ex |= LABEL_GLOSSY
     if not (lamp_flags & LF_VIS_TRANSMISSION):
+        ex |= LABEL_TRANSMIT
+    return ex
+
+
+@device
+def emitter_exclude(sc, tri):
+    """BSDF lobes emissive triangle ``tri`` must not illuminate: those whose rays do not see
+    its object (Cycles gives a mesh light the SHADER_EXCLUDE_* flags of its object's ray
+    visibility)."""
+    vis = int(sc.tex.objects[sc.tex.tri_object[tri], OBJ_VISIBILITY])
+    ex = 0
+    if not (vis & VIS_DIFFUSE):
+        ex |= LABEL_DIFFUSE
+    if not (vis & VIS_GLOSSY):
+        ex |= LABEL_GLOSSY
+    if not (vis & VIS_TRANSMISSION):
         ex |= LABEL_TRANSMIT
     return ex
 
@@ -378,4 +398,4 @@ def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2, time):
     emission = sc.mat_emission
     return LightSample(wix, wiy, wiz, dist, emission[em, 0] / pdf_l,
                        emission[em, 1] / pdf_l, emission[em, 2] / pdf_l,
-                       pdf_l, True, True, 0, lnx, lny, lnz, tri, b1, b2)
+                       pdf_l, True, True, emitter_exclude(sc, tri), lnx, lny, lnz, tri, b1, b2)

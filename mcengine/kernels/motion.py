@@ -696,27 +696,43 @@ def slot_hit(md, verts, tris, j, ox, oy, oz, dx, dy, dz, tmax, time, any_hit):
     return best, found
 
 
+@device
+def _sees(slot_masks, mask, i, j):
+    """Whether ray i sees slot j (its mask shares a bit with the slot's)."""
+    if mask.shape[0] == 0:
+        return True
+    m = mask[i] if mask.shape[0] > 1 else mask[0]
+    return (slot_masks[j] & m) != 0
+
+
 @kernel
-def moving_closest(md, verts, tris, o32, d32, time, best, prim):
-    """Lower ``best`` and update ``prim`` where a moving object is hit closer (n rays)."""
+def moving_closest(md, verts, tris, o32, d32, time, best, prim, slot_masks, mask):
+    """Lower ``best`` and update ``prim`` where a moving object is hit closer (n rays).
+    ``slot_masks``: each slot's visibility and ``mask`` the rays' (``intersect.Accel``;
+    empty: every ray sees every slot)."""
     for i in range(prim.shape[0]):
         ox, oy, oz = float(o32[i, 0]), float(o32[i, 1]), float(o32[i, 2])
         dx, dy, dz = float(d32[i, 0]), float(d32[i, 1]), float(d32[i, 2])
         for j in range(md.slot_info.shape[0]):
+            if not _sees(slot_masks, mask, i, j):
+                continue
             t, p = slot_hit(md, verts, tris, j, ox, oy, oz, dx, dy, dz, best[i], time[i], False)
             if p >= 0:
                 best[i], prim[i] = t, p
 
 
 @kernel
-def moving_occluded(md, verts, tris, o32, d32, t32, time, occluded):
-    """Set ``occluded`` where a moving object blocks the segment (0, t32) (n rays)."""
+def moving_occluded(md, verts, tris, o32, d32, t32, time, occluded, slot_masks, mask):
+    """Set ``occluded`` where a moving object blocks the segment (0, t32) (n rays; masks as
+    in ``moving_closest``)."""
     for i in range(occluded.shape[0]):
         if occluded[i]:
             continue
         ox, oy, oz = float(o32[i, 0]), float(o32[i, 1]), float(o32[i, 2])
         dx, dy, dz = float(d32[i, 0]), float(d32[i, 1]), float(d32[i, 2])
         for j in range(md.slot_info.shape[0]):
+            if not _sees(slot_masks, mask, i, j):
+                continue
             if slot_hit(md, verts, tris, j, ox, oy, oz, dx, dy, dz, float(t32[i]), time[i], True)[1] >= 0:
                 occluded[i] = True
                 break

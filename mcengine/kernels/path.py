@@ -62,7 +62,7 @@ from .closures.layout import (
     LABEL_TRANSPARENT,
     SSS_BURLEY,
 )
-from .intersect import offset_origin, offset_scale
+from .intersect import offset_origin, offset_scale, ray_masks
 from .light_sampling import (
     PMF_GLOBAL,
     PMF_LOCAL,
@@ -674,7 +674,11 @@ def trace_chunk(pixels, spp, accel, sc, cfg, fcfg, st, sq, scratch, film, stats,
         if not first:
             stats[ST_BOUNCE_RAYS] += n
         first = False
-        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n], st.time[:n])
+        mask = None
+        if accel.masked:
+            mask = np.empty(n, np.uint32)
+            ray_masks(st.flags[:n], mask)
+        prim = accel.closest(st.o32[:n], st.d32[:n], st.t32[:n], st.time[:n], mask)
         n_shadow = shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp)
         occluded = trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats)
         n = finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, pb, fp)

@@ -1,6 +1,7 @@
 """Shadow rays: is the light point visible, and how much light passes?
 
-Without transparent materials a shadow ray is one Embree occlusion query.
+Without transparent materials a shadow ray is one Embree occlusion query; shadow rays
+pass through the objects whose Shadow ray visibility is off (``VIS_SHADOW``).
 When some material lets shadow rays through (a Transparent BSDF, Principled
 Alpha, with the material's Transparent Shadows on), the queue is traced hit by
 hit instead: a hit on such a material multiplies the ray's light by the
@@ -17,7 +18,14 @@ import numpy as np
 from ..jit import kernel
 from .intersect import SHADOW_SHORTEN, intersect_triangle, offset_scale, prim_corners
 from .shading import shade_point
-from .state import CFG_MAX_TRANSPARENT, CFG_TRANSPARENT_SHADOWS, MF_TRANSPARENT, PF_SHADOW, ST_SHADOW_RAYS
+from .state import (
+    CFG_MAX_TRANSPARENT,
+    CFG_TRANSPARENT_SHADOWS,
+    MF_TRANSPARENT,
+    PF_SHADOW,
+    ST_SHADOW_RAYS,
+    VIS_SHADOW,
+)
 from .surface import surface_point
 
 # sq.alive values while tracing transparent shadows.
@@ -37,10 +45,10 @@ def trace_shadows(n_shadow, accel, sq, sc, cfg, scratch, stats):
     stats[ST_SHADOW_RAYS] += n_shadow
     if not cfg[CFG_TRANSPARENT_SHADOWS]:
         return accel.occluded(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow],
-                              sq.time[:n_shadow])
+                              sq.time[:n_shadow], VIS_SHADOW)
     for _ in range(int(cfg[CFG_MAX_TRANSPARENT]) + 2):
         prim = accel.closest(sq.o32[:n_shadow], sq.d32[:n_shadow], sq.t32[:n_shadow],
-                             sq.time[:n_shadow])
+                             sq.time[:n_shadow], VIS_SHADOW)
         if advance_shadows(n_shadow, prim, sq, sc, cfg, scratch) == 0:
             break
     return sq.alive[:n_shadow] != SHADOW_ARRIVED

@@ -145,6 +145,17 @@ PF_SUBSURFACE = 131072    # the ray ends where a subsurface walk left the object
 PF_DIFFUSE_ANCESTOR = 262144  # a diffuse bounce happened on the path (Cycles'
                               # PATH_RAY_DIFFUSE_ANCESTOR: Christensen-Burley turns Lambert)
 
+# Ray visibility (Object Properties > Visibility > Ray Visibility; Cycles' PATH_RAY_* bits
+# of an object's visibility): an object is hit only by rays whose mask shares a bit with
+# its own (``intersect.ray_visibility``; Embree's geometry and ray masks).
+VIS_CAMERA = 1
+VIS_DIFFUSE = 2
+VIS_GLOSSY = 4
+VIS_TRANSMISSION = 8
+VIS_SHADOW = 16
+VIS_SCATTER = 32          # volume scatter rays (no volumes yet: kept, never traced)
+VIS_ALL = 63
+
 # Integer settings (cfg array).
 CFG_MAX_BOUNCE = 0
 CFG_MAX_DIFFUSE = 1

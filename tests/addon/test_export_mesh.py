@@ -6,6 +6,7 @@ import bpy
 import numpy as np
 import pytest
 
+from mcengine.kernels.state import VIS_ALL, VIS_CAMERA, VIS_DIFFUSE, VIS_GLOSSY, VIS_SHADOW, VIS_TRANSMISSION
 from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
 
 from .helpers import CUBE_FACES, CUBE_VERTS, export_scene, new_mesh_object
@@ -281,14 +282,27 @@ def test_one_failing_object_is_skipped_with_a_warning(scene, fake_session, addon
     assert "object 'Bad' skipped: ValueError: broken mesh" in desc.warnings
 
 
-def test_hair_and_visibility_settings_are_named_once(scene, fake_session):
-    for i in range(7):
-        ob = new_mesh_object(f"Ghost{i}", TRI, [(0, 1, 2)])
-        ob.visible_camera = False
+def test_ray_visibility_is_exported_per_object_and_instance(scene, fake_session):
+    """Object > Visibility > Ray Visibility as VIS_* bits, an instance's ANDed with its
+    instancer's (Cycles' blender/object.cpp); nothing is warned."""
+    new_mesh_object("Plain", TRI, [(0, 1, 2)])
+    ghost = new_mesh_object("Ghost", TRI, [(0, 1, 2)])
+    ghost.visible_camera = False
+    shy = new_mesh_object("Shy", TRI, [(0, 1, 2)])
+    shy.visible_shadow, shy.visible_transmission = False, False
+    assets = bpy.data.collections.new("Assets")          # instanced only
+    new_mesh_object("Tri", TRI, [(0, 1, 2)], collection=assets).visible_glossy = False
+    empty = bpy.data.objects.new("Inst", None)
+    empty.instance_type, empty.instance_collection = "COLLECTION", assets
+    empty.visible_diffuse = False
+    scene.collection.objects.link(empty)
     desc = export_scene(fake_session)
-    notes = [w for w in desc.warnings if "ray visibility" in w]
-    assert notes == ["ray visibility not supported yet ('Ghost0', 'Ghost1', 'Ghost2', 'Ghost3', "
-                     "'Ghost4' and 2 more); these objects are visible to all rays"]
+    g = desc.geometry
+    visibility = dict(zip(g.object_names, g.visibility().tolist()))
+    assert visibility == {"Plain": VIS_ALL, "Ghost": VIS_ALL & ~VIS_CAMERA,
+                          "Shy": VIS_ALL & ~(VIS_SHADOW | VIS_TRANSMISSION),
+                          "Inst/Tri": VIS_ALL & ~(VIS_GLOSSY | VIS_DIFFUSE)}
+    assert not [w for w in desc.warnings if "visib" in w.lower()]
 
 
 def test_each_objects_shadow_terminator_offsets_are_exported(scene, fake_session):
@@ -346,10 +360,10 @@ def test_holdout_objects_and_collections_are_exported(scene, fake_session):
         "shadow catcher not supported yet ('Catcher'); these objects render as normal objects"]
 
 
-def test_indirect_only_collections_are_named(scene, fake_session):
-    """A collection set Indirect Only in the view layer (not rendered: its objects are seen
-    directly) is named in a warning with its objects; a holdout collection that is also
-    Indirect Only is a holdout, as in Cycles, and not named."""
+def test_indirect_only_collections_are_hidden_from_the_camera(scene, fake_session):
+    """A collection set Indirect Only in the view layer: its objects lose camera visibility
+    (Cycles' blender/object.cpp); a holdout collection that is also Indirect Only is a
+    holdout, as in Cycles, and keeps it."""
     for name, holdout in (("Bounce", False), ("Masked", True)):
         col = bpy.data.collections.new(name)
         scene.collection.children.link(col)
@@ -358,8 +372,10 @@ def test_indirect_only_collections_are_named(scene, fake_session):
         layer.indirect_only, layer.holdout = True, holdout
     new_mesh_object("Plain", TRI, [(0, 1, 2)])
     desc = export_scene(fake_session)
-    assert [w for w in desc.warnings if "indirect only" in w] == [
-        "indirect only collections not supported yet ('InBounce'); these objects are also seen directly"]
+    g = desc.geometry
+    visibility = dict(zip(g.object_names, g.visibility().tolist()))
+    assert visibility == {"InBounce": VIS_ALL & ~VIS_CAMERA, "InMasked": VIS_ALL, "Plain": VIS_ALL}
+    assert not [w for w in desc.warnings if "indirect" in w]
 
 
 def _attribute_grid(n=6):

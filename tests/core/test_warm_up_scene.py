@@ -43,17 +43,19 @@ def test_the_warm_up_render_runs_every_kernel_of_the_integrator(name, monkeypatc
 
 def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):
     """The world's importance bake, the mesh light's emission estimates, the moving
-    objects' BVH and their intersection kernels, the floor's true displacement: each
+    objects' BVH and their intersection kernels, the rays' visibility masks (the lamp is
+    hidden from the camera), the floor's true displacement: each
     compiled at a first render that needs it (about 2 minutes in all) if the warm-up did
     not run it."""
     called = set()
     for module, name in ((background, "bake_background"), (packing, "emission_estimates"),
                          (motion, "build_bvh"), (intersect, "moving_closest"),
-                         (intersect, "moving_occluded"), (displacement, "displacement_offsets")):
+                         (intersect, "moving_occluded"), (path, "ray_masks"),
+                         (displacement, "displacement_offsets")):
         def record(*args, _fn=getattr(module, name), _key=name):
             called.add(_key)
             return _fn(*args)
         monkeypatch.setattr(module, name, record)
     RenderSession(features_scene(), threads=1).run()
     assert called == {"bake_background", "emission_estimates", "build_bvh", "moving_closest",
-                      "moving_occluded", "displacement_offsets"}
+                      "moving_occluded", "ray_masks", "displacement_offsets"}

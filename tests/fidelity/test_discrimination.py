@@ -140,6 +140,24 @@ def test_ignored_holdouts_are_caught(renders):
     assert differing and all(d["t"] > 0 for d in differing), differing
 
 
+def _every_ray_sees_everything(scene):
+    for ob in scene.objects:
+        for ray in ("camera", "diffuse", "glossy", "transmission", "shadow"):
+            setattr(ob, f"visible_{ray}", True)
+    for layer in scene.view_layers:
+        layer.layer_collection.children["Indirect"].indirect_only = False
+
+
+def test_ignored_ray_visibility_is_caught(renders):
+    """Every object seen by every ray (what MC Engine rendered before it honoured Ray
+    Visibility): the camera-hidden balls, the box behind the pane and the panel show, the
+    box casts its shadow; blocks differ."""
+    result = renders.compare("ray_visibility", "every ray sees everything",
+                             _every_ray_sees_everything)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
 def _displacement_as_bump(scene):
     for name in ("Terrain", "Rock"):
         bpy.data.materials[name].displacement_method = "BUMP"

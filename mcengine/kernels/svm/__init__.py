@@ -63,6 +63,7 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     OBJ_TERMINATOR_SHADING,
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
+    OBJ_VISIBILITY,
     ShadingData,
     TextureData,
 )

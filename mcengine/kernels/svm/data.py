@@ -52,7 +52,8 @@ OBJ_COLOR = 32
 OBJ_TERMINATOR_GEOMETRY = 36  # Shadow Terminator: Geometry Offset (a cosine; 0: off)
 OBJ_TERMINATOR_SHADING = 37   # and Shading Offset s as Cycles keeps it: 1 / (1 - s / 2)
 OBJ_HOLDOUT = 38              # 1: a holdout object (camera rays reaching it clear the film)
-OBJ_STRIDE = 39
+OBJ_VISIBILITY = 39           # its ray visibility (state.VIS_* bits)
+OBJ_STRIDE = 40
 
 # The default UV map's offset in TextureData.attr (always present, 2 components).
 ATTR_DEFAULT_UV = 0

@@ -23,7 +23,18 @@ from .images import ImageTable
 from .kernels.camera import pack_camera
 from .kernels.light_sampling import light_distribution
 from .kernels.light_tree import S_STRIDE, build_emitter_tree, no_tree, sphere_rows
-from .kernels.lights import L_FLAGS, L_PMF, L_TYPE, LF_VIS_CAMERA, LIGHT_STRIDE, LT_SUN, pack_lights
+from .kernels.lights import (
+    L_FLAGS,
+    L_PMF,
+    L_TYPE,
+    LF_VIS_CAMERA,
+    LF_VIS_DIFFUSE,
+    LF_VIS_GLOSSY,
+    LF_VIS_TRANSMISSION,
+    LIGHT_STRIDE,
+    LT_SUN,
+    pack_lights,
+)
 from .kernels.motion import pack_motion
 from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, P_VECTOR, PassData
 from .kernels.sampling import SAMPLER_INDEPENDENT, filter_table
@@ -48,8 +59,8 @@ from .kernels.state import (
     CFG_SEED,
     CFG_SIZE,
     CFG_SOBOL_MASK,
-    CFG_WORLD_CAMERA,
     CFG_WORLD_SHADER,
+    CFG_WORLD_VISIBILITY,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_EMIT_SCALE,
@@ -250,7 +261,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     cfg[CFG_MIN_LIGHT_BOUNCES] = it.min_light_bounces
     cfg[CFG_SEED] = it.seed & 0x7FFFFFFFFFFFFFFF
     cfg[CFG_FILM_TRANSPARENT] = 1 if film.transparent else 0
-    cfg[CFG_WORLD_CAMERA] = 1 if scene.world.visible_camera else 0
+    cfg[CFG_WORLD_VISIBILITY] = world_visibility(scene.world)
     cfg[CFG_REGION_X], cfg[CFG_REGION_Y], cfg[CFG_REGION_W] = x0, y0, x1 - x0
     cfg[CFG_FULL_W] = film.width
     cfg[CFG_WORLD_SHADER] = 1 if world_varies else 0
@@ -294,6 +305,14 @@ def pack_attributes(g) -> tuple[AttributeLayout, np.ndarray]:
         columns.append(a)
         offset += a.shape[2]
     return layout, np.ascontiguousarray(np.concatenate(columns, axis=2))
+
+
+def world_visibility(world) -> int:
+    """The world's Ray Visibility as ``LF_VIS_*`` bits (a lamp's, ``lights.pack_lights``)."""
+    return ((LF_VIS_CAMERA if world.visible_camera else 0)
+            | (LF_VIS_DIFFUSE if world.visible_diffuse else 0)
+            | (LF_VIS_GLOSSY if world.visible_glossy else 0)
+            | (LF_VIS_TRANSMISSION if world.visible_transmission else 0))
 
 
 def pack_objects(g) -> np.ndarray:

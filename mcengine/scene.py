@@ -520,14 +520,19 @@ class World:
     (Background and Emission nodes emit their Color x Strength; Mix and Add
     Shader combine them; value nodes such as an Environment Texture feed them,
     the point being the ray's direction).  A world without ``nodes`` is the
-    constant radiance ``color``.  ``visible_camera`` is the camera ray
-    visibility; ``sampling`` and ``map_resolution`` are Cycles' world settings
+    constant radiance ``color``.  ``visible_camera``, ``visible_diffuse``,
+    ``visible_glossy`` and ``visible_transmission`` are its Ray Visibility (World >
+    Settings: which rays that escape see it, and which lobes its light samples light, as
+    Cycles' SHADER_EXCLUDE_* flags of the background); ``sampling`` and ``map_resolution`` are Cycles' world settings
     Sampling Method (None, Automatic, Manual) and Map Resolution: how next-event
     estimation samples the background.
     """
 
     color: tuple = (0.0509, 0.0509, 0.0509)
     visible_camera: bool = True
+    visible_diffuse: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
     nodes: list = field(default_factory=list)
     surface: Link | None = None
     sampling: str = "AUTOMATIC"

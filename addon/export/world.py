@@ -8,8 +8,8 @@ Scattering), Light Path, ...).  A graph whose radiance does not vary is rendered
 constant colour at no cost per ray.  Unsupported nodes (and the Sky Texture's other types)
 are warned, their consumer keeping its unlinked value.  Nothing linked: black, as in
 Cycles.  A world without a node tree uses ``world.color``; no world at all is black.  Cycles' world settings
-Sampling Method and Map Resolution are copied; the world's diffuse, glossy and
-transmission ray visibility switches are warned (the world lights everything).
+Sampling Method and Map Resolution are copied, and its Ray Visibility (camera, diffuse,
+glossy, transmission; volume scatter has no volume to light).
 """
 from __future__ import annotations
 
@@ -31,13 +31,10 @@ def export_world(ctx, world) -> World:
     if world is None:
         return World(color=BLACK)
     visibility = world.cycles_visibility
-    hidden = [ray for ray in ("diffuse", "glossy", "transmission", "scatter")
-              if not getattr(visibility, ray)]
-    if hidden:
-        ctx.warn(f"world '{world.name}': ray visibility ({', '.join(hidden)} off) not supported "
-                 f"yet; the world lights everything", "world ray visibility")
     settings = getattr(world, "cycles", None)
-    common = dict(visible_camera=bool(visibility.camera),
+    common = dict(visible_camera=bool(visibility.camera), visible_diffuse=bool(visibility.diffuse),
+                  visible_glossy=bool(visibility.glossy),
+                  visible_transmission=bool(visibility.transmission),
                   sampling=str(getattr(settings, "sampling_method", "AUTOMATIC")),
                   map_resolution=int(getattr(settings, "sample_map_resolution", 1024)))
     tree = world.node_tree

@@ -51,10 +51,13 @@ from .light_sampling import (
     PMF_LOCAL,
     LightSample,
     emission_weight,
+    lamp_visible_to_ray,
     lamps_on_segment,
+    nee_exclude,
     sample_light,
     sun_light,
 )
+from .lights import LF_USE_MIS
 from .sampling import power_heuristic
 from .state import (
     CFG_CAUSTICS_REFLECTIVE,
@@ -63,7 +66,7 @@ from .state import (
     CFG_LAMPS_HIT,
     CFG_MAX_TRANSPARENT,
     CFG_WORLD,
-    CFG_WORLD_CAMERA,
+    CFG_WORLD_VISIBILITY,
     FCFG_CLAMP_DIRECT,
     FCFG_CLAMP_INDIRECT,
     FCFG_WORLD_IMPORTANCE,
@@ -282,7 +285,10 @@ def light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, d
                      pmf_mode, mis_total, direct):
     """The world's part of ``light_from_background`` (returns the film transparency)."""
     transparent_film = cfg[CFG_FILM_TRANSPARENT] != 0 and (flags & PF_TRANSPARENT_BG) != 0
-    if not transparent_film and cfg[CFG_WORLD] and (cfg[CFG_WORLD_CAMERA] or not (flags & PF_CAMERA)):
+    # The world is seen by the rays its Ray Visibility lets see it (as a lamp that MIS can
+    # hit: Cycles' is_light_shader_visible_to_path of the background shader).
+    if not transparent_film and cfg[CFG_WORLD] and lamp_visible_to_ray(
+            flags, int(cfg[CFG_WORLD_VISIBILITY]) | LF_USE_MIS):
         wr, wg, wb = world_radiance(sc, cfg, scratch, dx, dy, dz, flags)
         # MIS against next-event estimation's sample of the world (when it makes one).
         pick = 0.0
@@ -421,7 +427,8 @@ def light_from_emitter(sc, fcfg, stats, out, row, beta, i, p, t_hit, sp, flags, 
 def world_light_sample(sc, cfg, scratch, pmf, u1, u2):
     """A direction towards the world drawn from its importance map and sun cone (picked
     with probability ``pmf``), as a :class:`LightSample` (radiance from the world's shader,
-    evaluated as for a light: no ray-type flags)."""
+    evaluated as for a light: no ray-type flags); it lights only the lobes whose rays see
+    the world (its Ray Visibility)."""
     wix, wiy, wiz, pdf = sample_world(sc, u1, u2)
     pdf_l = pmf * pdf
     if pdf_l <= 0.0:
@@ -429,7 +436,7 @@ def world_light_sample(sc, cfg, scratch, pmf, u1, u2):
                            0.0, 0.0, 0.0, -1, 0.0, 0.0)
     r, g, b = world_radiance(sc, cfg, scratch, wix, wiy, wiz, 0)
     return LightSample(wix, wiy, wiz, math.inf, r / pdf_l, g / pdf_l, b / pdf_l, pdf_l, True, True,
-                       0, 0.0, 0.0, 0.0, -1, 0.0, 0.0)
+                       nee_exclude(int(cfg[CFG_WORLD_VISIBILITY])), 0.0, 0.0, 0.0, -1, 0.0, 0.0)
 
 
 @device

@@ -184,9 +184,20 @@ def test_no_world_is_black(scene, fake_session):
     assert export_scene(fake_session).world.color == (0, 0, 0)
 
 
-def test_world_camera_visibility(scene, fake_session):
-    world_with_background((1, 1, 1), 1.0).cycles_visibility.camera = False
-    assert export_scene(fake_session).world.visible_camera is False
+def test_world_ray_visibility(scene, fake_session):
+    """World > Settings > Ray Visibility: each switch exported, none warned."""
+    visibility = world_with_background((1, 1, 1), 1.0).cycles_visibility
+    visibility.camera, visibility.glossy = False, False
+    desc = export_scene(fake_session)
+    w = desc.world
+    assert (w.visible_camera, w.visible_diffuse, w.visible_glossy, w.visible_transmission) == \
+        (False, True, False, True)
+    visibility.camera, visibility.glossy = True, True
+    visibility.diffuse, visibility.transmission = False, False
+    w = export_scene(fake_session).world
+    assert (w.visible_camera, w.visible_diffuse, w.visible_glossy, w.visible_transmission) == \
+        (True, False, True, False)
+    assert not [x for x in desc.warnings if "visibility" in x]
 
 
 def test_sky_texture_types_other_than_multiple_scattering_use_the_unlinked_value(scene, fake_session):

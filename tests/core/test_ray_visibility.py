@@ -198,3 +198,40 @@ def test_a_moving_cover_keeps_its_visibility(visibility, expected):
         assert s.image()[..., :3].max() == 0.0
     else:
         assert_mean(s, SUN / math.pi)
+
+
+# -- the world's Ray Visibility (World > Settings > Ray Visibility) ----------------------------
+WORLD = 0.5
+
+
+def _world_lit(material: Material, **visibility):
+    """The floor of ``material`` under a constant world W alone (no lamp, no cover)."""
+    scene = plane_scene(Light(), samples=64, res=8, bounces=4, world=(WORLD,) * 3)
+    scene.lights = []
+    scene.materials = [material]
+    for ray, on in visibility.items():
+        setattr(scene.world, f"visible_{ray}", on)
+    return scene
+
+
+MIRROR = Material(nodes=[ShaderNode("BsdfGlossy", {"Color": (1.0,) * 3, "Roughness": 0.0})],
+                  surface=Link(0, "BSDF"))
+
+
+@pytest.mark.parametrize("material, visibility, expected", [
+    (Material(base_color=(1.0,) * 3), {}, WORLD),                       # Lambert: W
+    (Material(base_color=(1.0,) * 3), {"diffuse": False}, 0.0),
+    (Material(base_color=(1.0,) * 3), {"glossy": False, "transmission": False}, WORLD),
+    (MIRROR, {}, WORLD),                                                 # a mirror shows W
+    (MIRROR, {"glossy": False}, 0.0),
+    (MIRROR, {"diffuse": False}, WORLD),
+])
+def test_the_world_lights_only_the_lobes_whose_rays_see_it(material, visibility, expected):
+    """A white Lambert floor or a white mirror under a constant world: W, or nothing when
+    the world is hidden from the rays of its lobe (its light samples leave that lobe out,
+    the lobe's rays that escape find nothing)."""
+    s = render(_world_lit(material, **visibility))
+    if expected == 0.0:
+        assert s.image()[..., :3].max() == 0.0
+    else:
+        assert_mean(s, expected)

@@ -26,6 +26,18 @@ def test_same_triangles_reuse_the_bvh_and_others_rebuild_it():
     accel_cache.clear()
 
 
+def test_the_same_triangles_with_another_ray_visibility_rebuild_it():
+    """Objects hidden from some rays are another BVH (Embree's geometry masks)."""
+    accel_cache.clear()
+    plain, _ = accel_cache.accel_for(VERTICES, TRIANGLES)
+    hidden = np.array([1, 63], np.uint8)
+    masked, reused = accel_cache.accel_for(VERTICES, TRIANGLES, visibility=hidden)
+    assert not reused and masked is not plain and masked.masked
+    assert accel_cache.accel_for(VERTICES, TRIANGLES, visibility=hidden.copy())[0] is masked
+    assert not accel_cache.accel_for(VERTICES, TRIANGLES)[1]
+    accel_cache.clear()
+
+
 def test_a_scene_without_triangles_has_a_bvh_too():
     """A world preview or an empty scene: no triangles, nothing hit, reused like any other."""
     accel_cache.clear()

@@ -26,7 +26,16 @@ from mcengine.kernels.state import (
     VIS_TRANSMISSION,
 )
 from mcengine.packing import pack_scene
-from mcengine.scene import Geometry, Light, Link, Material, SceneDescription, SceneError, ShaderNode
+from mcengine.scene import (
+    Geometry,
+    Light,
+    Link,
+    Material,
+    SceneDescription,
+    SceneError,
+    ShaderNode,
+    World,
+)
 
 from .expect import assert_mean, render
 from .scenes import grid_plane, plane_scene, rotation_x
@@ -204,11 +213,17 @@ def test_a_moving_cover_keeps_its_visibility(visibility, expected):
 WORLD = 0.5
 
 
-def _world_lit(material: Material, **visibility):
-    """The floor of ``material`` under a constant world W alone (no lamp, no cover)."""
+def _world_lit(material: Material, varying: bool = False, **visibility):
+    """The floor of ``material`` under a constant world W alone (no lamp, no cover), or a
+    world that varies (a Gradient texture along x as its colour: sampled by next-event
+    estimation from its importance map, which a constant world is not)."""
     scene = plane_scene(Light(), samples=64, res=8, bounces=4, world=(WORLD,) * 3)
     scene.lights = []
     scene.materials = [material]
+    if varying:
+        scene.world = World(nodes=[ShaderNode("TexGradient"),
+                                   ShaderNode("Background", {"Color": Link(0, "Color")})],
+                            surface=Link(1, "Background"))
     for ray, on in visibility.items():
         setattr(scene.world, f"visible_{ray}", on)
     return scene
@@ -235,3 +250,15 @@ def test_the_world_lights_only_the_lobes_whose_rays_see_it(material, visibility,
         assert s.image()[..., :3].max() == 0.0
     else:
         assert_mean(s, expected)
+
+
+@pytest.mark.parametrize("hidden", ["diffuse", "glossy"])
+def test_a_world_sampled_as_a_light_lights_only_the_lobes_whose_rays_see_it(hidden):
+    """A varying world, which next-event estimation samples: the Lambert floor gets nothing
+    when the world is hidden from diffuse rays (its light samples leave the diffuse lobe
+    out), and its light otherwise."""
+    s = render(_world_lit(Material(base_color=(1.0,) * 3), varying=True, **{hidden: False}))
+    if hidden == "diffuse":
+        assert s.image()[..., :3].max() == 0.0
+    else:
+        assert s.image()[..., :3].min() > 0.05

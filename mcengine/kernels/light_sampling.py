@@ -160,16 +160,24 @@ def lamp_visible_to_ray(flags, lamp_flags):
 
 
 @device
-def nee_exclude(lamp_flags):
-    """BSDF lobes a light must not illuminate (its ray-visibility switches)."""
+def hidden_lobes(diffuse, glossy, transmission):
+    """BSDF lobes a light must not illuminate: those whose rays do not see it (``diffuse``,
+    ``glossy``, ``transmission``: whether rays of that kind do; Cycles' SHADER_EXCLUDE_*)."""
     ex = 0
-    if not (lamp_flags & LF_VIS_DIFFUSE):
+    if not diffuse:
         ex |= LABEL_DIFFUSE
-    if not (lamp_flags & LF_VIS_GLOSSY):
+    if not glossy:
         ex |= LABEL_GLOSSY
-    if not (lamp_flags & LF_VIS_TRANSMISSION):
+    if not transmission:
         ex |= LABEL_TRANSMIT
     return ex
+
+
+@device
+def nee_exclude(lamp_flags):
+    """BSDF lobes a lamp (or the world) must not illuminate (its ray-visibility switches)."""
+    return hidden_lobes(lamp_flags & LF_VIS_DIFFUSE, lamp_flags & LF_VIS_GLOSSY,
+                        lamp_flags & LF_VIS_TRANSMISSION)
 
 
 @device
@@ -178,14 +186,7 @@ def emitter_exclude(sc, tri):
     its object (Cycles gives a mesh light the SHADER_EXCLUDE_* flags of its object's ray
     visibility)."""
     vis = int(sc.tex.objects[sc.tex.tri_object[tri], OBJ_VISIBILITY])
-    ex = 0
-    if not (vis & VIS_DIFFUSE):
-        ex |= LABEL_DIFFUSE
-    if not (vis & VIS_GLOSSY):
-        ex |= LABEL_GLOSSY
-    if not (vis & VIS_TRANSMISSION):
-        ex |= LABEL_TRANSMIT
-    return ex
+    return hidden_lobes(vis & VIS_DIFFUSE, vis & VIS_GLOSSY, vis & VIS_TRANSMISSION)
 
 
 @device

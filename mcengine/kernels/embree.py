@@ -35,7 +35,7 @@ from numba.extending import intrinsic
 
 from ..jit import kernel
 
-__all__ = ["PACKET", "build", "build_local", "intersect_one", "library_path"]
+__all__ = ["NO_MASKS", "PACKET", "build", "build_local", "intersect_one", "library_path", "mask_array"]
 
 PACKET = 8                 # rays per Embree call (RTCRayHit8); 16 measured no faster here
 _ALIGN = 64                # bytes; Embree's packet structures are aligned to their width
@@ -226,19 +226,19 @@ class _PacketScene:
         trace_packets(fn, self._scene, np.ascontiguousarray(origins, np.float32),
                       np.ascontiguousarray(directions, np.float32),
                       np.ascontiguousarray(tfar, np.float32), out, occlusion,
-                      packet, packet.view(np.uint32), valid, _ray_masks(mask), self._first,
+                      packet, packet.view(np.uint32), valid, mask_array(mask), self._first,
                       self._ids)
 
 
-def _ray_masks(mask):
-    """A query's ray masks for trace_packets: none (every ray sees everything), one for all
-    rays, or one per ray."""
+def mask_array(mask):
+    """A query's ray masks as the compiled tracers take them: none (every ray sees
+    everything), one for all rays, or one per ray."""
     if mask is None:
-        return _NO_MASKS
+        return NO_MASKS
     return np.atleast_1d(np.asarray(mask, np.uint32))
 
 
-_NO_MASKS = np.zeros(0, np.uint32)
+NO_MASKS = np.zeros(0, np.uint32)
 
 
 class _EmbreexScene:

@@ -89,7 +89,7 @@ class Accel:
         self._static_ids = None
         if visibility is not None and np.all(np.asarray(visibility) & VIS_ALL == VIS_ALL):
             visibility = None
-        self._slot_masks = _NO_MASKS
+        self._slot_masks = embree.NO_MASKS
         if visibility is not None:
             visibility = np.asarray(visibility, np.uint32) & VIS_ALL
         if self._motion is not None:
@@ -126,7 +126,7 @@ class Accel:
         best = np.empty(n)
         hit_distances(self._verts, self._tris, origins, directions, tfar, prim, best)
         moving_closest(self._motion, self._verts, self._tris, origins, directions,
-                       _times(time, n), best, prim, self._slot_masks, _masks(mask))
+                       _times(time, n), best, prim, self._slot_masks, embree.mask_array(mask))
         return prim
 
     def occluded(self, origins, directions, tfar, time=None, mask=None):
@@ -140,15 +140,8 @@ class Accel:
             blocked = self._scene.occluded(origins, directions, tfar, mask)
         if self._motion is not None and n:
             moving_occluded(self._motion, self._verts, self._tris, origins, directions, tfar,
-                            _times(time, n), blocked, self._slot_masks, _masks(mask))
+                            _times(time, n), blocked, self._slot_masks, embree.mask_array(mask))
         return blocked
-
-
-_NO_MASKS = np.zeros(0, np.uint32)
-
-
-def _masks(mask):
-    return _NO_MASKS if mask is None else np.atleast_1d(np.asarray(mask, np.uint32))
 
 
 @device

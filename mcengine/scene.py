@@ -523,7 +523,8 @@ class World:
     constant radiance ``color``.  ``visible_camera``, ``visible_diffuse``,
     ``visible_glossy`` and ``visible_transmission`` are its Ray Visibility (World >
     Settings: which rays that escape see it, and which lobes its light samples light, as
-    Cycles' SHADER_EXCLUDE_* flags of the background); ``sampling`` and ``map_resolution`` are Cycles' world settings
+    Cycles' SHADER_EXCLUDE_* flags of the background); ``sampling`` and
+    ``map_resolution`` are Cycles' world settings
     Sampling Method (None, Automatic, Manual) and Map Resolution: how next-event
     estimation samples the background.
     """

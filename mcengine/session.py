@@ -351,11 +351,12 @@ class RenderSession:
         self.active = np.arange(self.film.count.size, dtype=np.int32)
         self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
+        visibility = scene.geometry.triangle_visibility()
         self.accel, self.stats.extra["bvh_reused"] = accel_cache.accel_for(
-            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion,
-            scene.geometry.triangle_visibility())
+            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion, visibility)
         self.stats.time_bvh = time.perf_counter() - t0
-        self._warn_ray_visibility(scene)
+        if visibility is not None:
+            self._warn_ray_visibility()
         t0 = time.perf_counter()
         self._warm_up()
         self.stats.time_kernels = time.perf_counter() - t0
@@ -365,10 +366,9 @@ class RenderSession:
         self._buffer_bytes = 0
         self._lock = threading.Lock()
 
-    def _warn_ray_visibility(self, scene) -> None:
-        """Name where objects' Ray Visibility is not honoured (every ray sees them there)."""
-        if scene.geometry.triangle_visibility() is None:
-            return
+    def _warn_ray_visibility(self) -> None:
+        """Name where objects' Ray Visibility (some object's) is not honoured (every ray
+        sees them there)."""
         if not self.accel.masked:
             self.warnings.append("Ray Visibility needs Embree's library, which was not found "
                                  "(embreex's own API has no ray masks): every object is seen "

@@ -58,6 +58,7 @@ SCENES = (
     "material_displacement",
     "material_subsurface",
     "ray_visibility",
+    "light_linking",
 )
 
 

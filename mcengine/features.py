@@ -23,6 +23,8 @@ subsurface walks     a material has a subsurface closure      a hierarchy over e
                      (Principled Subsurface Weight, the       triangles; random walks inside them
                      Subsurface Scattering node)              (without it: Lambert, the zero-radius
                                                               limit)
+light linking        a lamp or emissive object lights only    a light-set test per light sample and
+                     some objects (Object > Light Linking)    per lamp or emission a ray finds
 ==================== ======================================== ======================================
 
 The camera's effects cost nothing when absent without a flag: no lens sample is
@@ -48,10 +50,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .kernels.lights import LIGHT_SETS_ALL
 from .kernels.motion import moves
 from .kernels.state import (
     CFG_CAUSTICS,
     CFG_LAMPS_HIT,
+    CFG_LIGHT_LINKING,
     CFG_LIGHTS,
     CFG_MIS,
     CFG_SUBSURFACE,
@@ -72,6 +76,7 @@ EFFECTS = {
     "transparent_shadows": ("transparent shadows", CFG_TRANSPARENT_SHADOWS),
     "caustics": ("caustic paths", CFG_CAUSTICS),
     "subsurface": ("subsurface walks", CFG_SUBSURFACE),
+    "light_linking": ("light linking", CFG_LIGHT_LINKING),
 }
 
 
@@ -94,6 +99,7 @@ class EffectsPlan:
     transparent_shadows: bool = False
     caustics: bool = False
     subsurface: bool = False
+    light_linking: bool = False
     forced: tuple = ()             # effects forced on although the scene does not call for them
 
     def force(self, names) -> "EffectsPlan":
@@ -206,7 +212,14 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         mis=nee and (lamps_hit or emissive_triangles > 0 or world_sampled),
         caustics=nee and bool(kinds & CASTERS) and bool(kinds & RECEIVERS),
         subsurface="subsurface" in kinds,
+        light_linking=nee and light_linked(lamps, scene.geometry),
     )
+
+
+def light_linked(lamps, geometry) -> bool:
+    """Whether some lamp or object lights only some of the light sets (light linking)."""
+    return (any(int(li.light_sets) != LIGHT_SETS_ALL for li in lamps)
+            or bool(np.any(geometry.light_sets() != np.uint64(LIGHT_SETS_ALL))))
 
 
 def displaced_meshes(geometry) -> int:

@@ -31,8 +31,10 @@ from .kernels.lights import (
     LF_VIS_DIFFUSE,
     LF_VIS_GLOSSY,
     LF_VIS_TRANSMISSION,
+    LIGHT_SETS_ALL,
     LIGHT_STRIDE,
     LT_SUN,
+    light_set_columns,
     pack_lights,
 )
 from .kernels.motion import pack_motion
@@ -83,9 +85,11 @@ from .kernels.svm import (
     OBJ_COLOR,
     OBJ_HOLDOUT,
     OBJ_INVERSE,
+    OBJ_LIGHT_SETS,
     OBJ_MATRIX,
     OBJ_PASS_INDEX,
     OBJ_RANDOM,
+    OBJ_RECEIVER_SET,
     OBJ_STRIDE,
     OBJ_TERMINATOR_GEOMETRY,
     OBJ_TERMINATOR_SHADING,
@@ -331,6 +335,9 @@ def pack_objects(g) -> np.ndarray:
     out[:o, OBJ_HOLDOUT] = [1.0 if info.holdout else 0.0 for info in g.object_pass_info()]
     out[:, OBJ_VISIBILITY] = VIS_ALL
     out[:o, OBJ_VISIBILITY] = g.visibility()
+    out[:o, OBJ_RECEIVER_SET] = g.receiver_sets()
+    out[:, OBJ_LIGHT_SETS:OBJ_LIGHT_SETS + 2] = light_set_columns([LIGHT_SETS_ALL])
+    out[:o, OBJ_LIGHT_SETS:OBJ_LIGHT_SETS + 2] = light_set_columns(g.light_sets())
     terminator = g.terminator_offsets() if o else np.array([DEFAULT_TERMINATOR_OFFSETS])
     out[:, OBJ_TERMINATOR_GEOMETRY] = terminator[:, 0]
     # Cycles keeps the Shading Offset s as the frequency of its shift_cos_in (scene/object.cpp).

@@ -29,6 +29,7 @@ import numpy as np
 
 from . import integrators, memory, samplers
 from .denoise import Denoising
+from .kernels.lights import LIGHT_SETS_ALL, MAX_LIGHT_SETS
 from .kernels.state import VIS_ALL
 from .passes import RenderPasses
 
@@ -102,6 +103,10 @@ class Geometry:
     object_visibility (O,) uint8    Ray Visibility: the rays that see the object, ``VIS_*`` bits
                     (``kernels.state``: camera, diffuse, glossy, transmission, shadow, volume
                     scatter; absent: every ray)
+    object_receiver_set (O,) uint8  light linking: the light set the object receives
+                    (0..63, 0 the default set; absent: every object 0)
+    object_light_sets (O,) uint64   light linking: as an emitter (emissive material), the
+                    receivers' light sets it lights (bit s: set s; absent: all of them)
     """
 
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
@@ -118,6 +123,8 @@ class Geometry:
     object_terminator: np.ndarray | None = None
     object_passes: list = field(default_factory=list)
     object_visibility: np.ndarray | None = None
+    object_receiver_set: np.ndarray | None = None
+    object_light_sets: np.ndarray | None = None
 
     @property
     def num_objects(self) -> int:
@@ -158,6 +165,18 @@ class Geometry:
         if self.object_visibility is not None:
             return np.asarray(self.object_visibility, np.uint8)
         return np.full(self.num_objects, VIS_ALL, np.uint8)
+
+    def receiver_sets(self) -> np.ndarray:
+        """(O,) uint8: each object's receiver light set, the default (0) filled in."""
+        if self.object_receiver_set is not None:
+            return np.asarray(self.object_receiver_set, np.uint8)
+        return np.zeros(self.num_objects, np.uint8)
+
+    def light_sets(self) -> np.ndarray:
+        """(O,) uint64: the light sets each object lights as an emitter (all by default)."""
+        if self.object_light_sets is not None:
+            return np.asarray(self.object_light_sets, np.uint64)
+        return np.full(self.num_objects, LIGHT_SETS_ALL, np.uint64)
 
     def triangle_visibility(self) -> np.ndarray | None:
         """(T,) uint8: the ray visibility of each triangle's object; None when every object
@@ -244,7 +263,11 @@ class Geometry:
             object_terminator=np.concatenate([g.terminator_offsets() for g in parts]),
             object_passes=infos,
             object_visibility=(None if all(g.object_visibility is None for g in parts)
-                               else np.concatenate([g.visibility() for g in parts])))
+                               else np.concatenate([g.visibility() for g in parts])),
+            object_receiver_set=(None if all(g.object_receiver_set is None for g in parts)
+                                 else np.concatenate([g.receiver_sets() for g in parts])),
+            object_light_sets=(None if all(g.object_light_sets is None for g in parts)
+                               else np.concatenate([g.light_sets() for g in parts])))
 
 
 def auto_texspace_size(texspace: np.ndarray) -> np.ndarray:
@@ -402,6 +425,7 @@ class Light:
     visible_glossy: bool = True
     visible_transmission: bool = True
     max_bounces: int = 1024
+    light_sets: int = LIGHT_SETS_ALL  # light linking: the receivers' light sets it lights
     name: str = "Light"
 
 
@@ -671,6 +695,18 @@ class SceneDescription:
                 or np.any((np.asarray(g.object_visibility, np.int64) & ~VIS_ALL) != 0)):
             raise SceneError(f"geometry.object_visibility must hold ({o},) masks of VIS_* bits "
                              f"(0..{VIS_ALL})")
+        if g.object_receiver_set is not None and (
+                np.shape(g.object_receiver_set) != (o,)
+                or np.any(np.asarray(g.object_receiver_set, np.int64) >= MAX_LIGHT_SETS)
+                or np.any(np.asarray(g.object_receiver_set, np.int64) < 0)):
+            raise SceneError(f"geometry.object_receiver_set must hold ({o},) light sets "
+                             f"(0..{MAX_LIGHT_SETS - 1})")
+        if g.object_light_sets is not None and (
+                np.shape(g.object_light_sets) != (o,)
+                or np.asarray(g.object_light_sets).dtype.kind not in "iu"
+                or np.any(np.asarray(g.object_light_sets) < 0)):
+            raise SceneError(f"geometry.object_light_sets must hold ({o},) masks of light sets "
+                             f"(unsigned 64-bit integers)")
         if g.object_terminator is not None and not np.all(
                 (np.asarray(g.object_terminator) >= 0.0) & (np.asarray(g.object_terminator) <= 1.0)):
             raise SceneError("geometry.object_terminator: the Shadow Terminator offsets must lie "
@@ -704,6 +740,9 @@ class SceneDescription:
             _check_number(where, "spot_size", li.spot_size, lo=0.0, hi=PI_FLOAT32)
             _check_number(where, "spread", li.spread, lo=0.0, hi=PI_FLOAT32)
             _check_number(where, "max_bounces", li.max_bounces, lo=0)
+            if not (isinstance(li.light_sets, (int, np.integer)) and 0 <= li.light_sets <= LIGHT_SETS_ALL):
+                raise SceneError(f"{where}: light_sets must be a mask of light sets "
+                                 f"(an integer in 0..2^{MAX_LIGHT_SETS} - 1), got {li.light_sets!r}")
         _check_vector("world", "color", self.world.color, 3)
         _check_graph("world", self.world)
         if self.world.sampling not in WORLD_SAMPLING:
@@ -822,6 +861,7 @@ class SceneDescription:
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
             object_matrix=matrix, object_texspace=texspace, object_info=info,
             object_terminator=g.terminator_offsets(), object_visibility=g.visibility(),
+            object_receiver_set=g.receiver_sets(), object_light_sets=g.light_sets(),
             **attributes,
             **images, meta=np.frombuffer(json.dumps(meta).encode(), np.uint8))
 
@@ -860,7 +900,8 @@ _SAVED_ARRAYS = {
 }
 _OPTIONAL_ARRAYS = {"object_matrix": ("f", (4, 4)), "object_texspace": ("f", (2, 3)),
                     "object_info": ("f", (6,)), "object_terminator": ("f", (2,)),
-                    "object_visibility": ("iu", ())}
+                    "object_visibility": ("iu", ()), "object_receiver_set": ("iu", ()),
+                    "object_light_sets": ("iu", ())}
 MAX_META_BYTES = 64 << 20
 
 
@@ -910,6 +951,8 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
                     object_matrix=z.get("object_matrix"), object_texspace=z.get("object_texspace"),
                     object_info=z.get("object_info"), object_terminator=z.get("object_terminator"),
                     object_visibility=z.get("object_visibility"),
+                    object_receiver_set=z.get("object_receiver_set"),
+                    object_light_sets=z.get("object_light_sets"),
                     object_passes=[ObjectPassInfo(**o) for o in meta.get("object_passes", [])])
     lights = []
     for d in meta["lights"]:
@@ -981,6 +1024,7 @@ def _plain(d: dict) -> dict:
 def _light_meta(li: Light) -> dict:
     d = _plain(dataclasses.asdict(li))
     d["strength"] = [float(x) for x in d["strength"]]
+    d["light_sets"] = int(d["light_sets"])
     return {k: (float(v) if isinstance(v, np.floating) else v) for k, v in d.items()}
 
 

@@ -333,6 +333,9 @@ class RenderSession:
             self.warnings.append(f"{self.integrator.name} does not render holdouts (Holdout "
                                  f"shaders and holdout objects): they render as ordinary "
                                  f"surfaces; Path Tracing renders them as Cycles")
+        if self._classic and self.plan.light_linking:
+            self.warnings.append(f"{self.integrator.name} does not honour light linking: every "
+                                 f"light lights every object; Path Tracing honours it as Cycles")
         guides = ((P_DENOISING_ALBEDO,) if scene.denoising.uses_albedo else ()) + \
             ((P_DENOISING_NORMAL,) if scene.denoising.uses_normal else ())
         self.pass_layout = render_passes.layout(scene.passes, guides)

@@ -166,10 +166,6 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
 
-# Light and shadow linking (Object > Shading > Light Linking / Shadow Linking on a light or an
-# emissive object): the collection each sets, and what MC Engine renders instead.
-_LINKING = {"light linking": ("receiver_collection", "their light reaches every object"),
-            "shadow linking": ("blocker_collection", "every object casts their shadows")}
 
 
 def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = False):
@@ -179,22 +175,18 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
     are None without ``meshes``."""
     from . import lights, materials, mesh, motion
 
+    links = _light_links(ctx, depsgraph)
     table = materials.MaterialTable(ctx)
-    collector = mesh.MeshCollector(ctx, table, depsgraph.view_layer) if meshes else None
+    collector = mesh.MeshCollector(ctx, table, depsgraph.view_layer, links) if meshes else None
     light_list = []
-    linked = {}
     for inst in depsgraph.object_instances:
         if not inst.show_self:
             continue
         ob = inst.object
-        linking = getattr(ob, "light_linking", None)
-        for feature, (collection, _fallback) in _LINKING.items():
-            names = linked.setdefault(feature, [])
-            if getattr(linking, collection, None) is not None and _instance_name(inst) not in names:
-                names.append(_instance_name(inst))
         try:
             if ob.type == "LIGHT":
-                light = lights.export_light(ctx, ob, inst.matrix_world.copy(), _instance_name(inst))
+                light = lights.export_light(ctx, ob, inst.matrix_world.copy(), _instance_name(inst),
+                                            links.light_sets(ob))
                 if light is not None:
                     light_list.append(light)
             elif collector is not None:
@@ -208,12 +200,27 @@ def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = Fal
                 collector.add(inst, _instance_name(inst), tag)
         except Exception as exc:  # one bad object must not abort the render
             ctx.warn(f"object '{_instance_name(inst)}' skipped: {type(exc).__name__}: {exc}")
-    for feature, names in linked.items():
-        if names:
-            ctx.warn(f"{feature} not supported yet ({mesh.listed(names)}); {_LINKING[feature][1]}", feature)
     if collector is None:
         return None, None, light_list, None
     return collector.geometry(), table.materials, light_list, collector.layout
+
+
+def _light_links(ctx, depsgraph):
+    """The light sets of the depsgraph's objects (``linking.LightLinks``), with a warning for
+    what is not linked: shadow linking, and links beyond Blender's limits."""
+    import bpy
+
+    from . import linking, mesh
+    objects = [ob for ob in depsgraph.ids if isinstance(ob, bpy.types.Object)]
+    links = linking.LightLinks(objects)
+    for line in links.warnings:
+        ctx.warn(line, "light linking")
+    blocked = sorted(ob.name for ob in objects
+                     if getattr(getattr(ob, "light_linking", None), "blocker_collection", None))
+    if blocked:
+        ctx.warn(f"shadow linking not supported yet ({mesh.listed(blocked)}); every object casts "
+                 f"their shadows", "shadow linking")
+    return links
 
 
 def _materials_in_order(ctx, depsgraph) -> list:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mcengine.kernels.lights import LIGHT_SETS_ALL
 from mcengine.scene import Light
 
 from .materials import linked_node
@@ -28,7 +29,8 @@ from .materials import linked_node
 __all__ = ["export_light"]
 
 
-def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
+def export_light(ctx, ob, matrix_world, name: str,
+                 light_sets: int = LIGHT_SETS_ALL) -> Light | None:
     """Convert one evaluated lamp object (None for lamps that emit nothing: portals).
 
     Parameters
@@ -40,6 +42,8 @@ def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
         The instance's world matrix (already copied), in Blender units.
     name : str
         Name for messages.
+    light_sets : int
+        The light sets it lights (light linking, ``linking.LightLinks.light_sets``).
     """
     data = ob.data
     cycles = getattr(data, "cycles", None)
@@ -67,6 +71,7 @@ def export_light(ctx, ob, matrix_world, name: str) -> Light | None:
         visible_diffuse=bool(ob.visible_diffuse),
         visible_glossy=bool(ob.visible_glossy),
         visible_transmission=bool(ob.visible_transmission),
+        light_sets=int(light_sets),
     )
     if data.type in ("POINT", "SPOT"):
         light.radius = float(data.shadow_soft_size) * s

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
+from mcengine.kernels.lights import LIGHT_SETS_ALL
 from mcengine.kernels.state import (
     VIS_CAMERA,
     VIS_DIFFUSE,
@@ -133,11 +134,14 @@ class MeshCollector:
         Maps each object's material slots to scene material indices.
     view_layer : bpy.types.ViewLayer, optional
         The depsgraph's view layer, where an object's collections may make it a holdout.
+    links : linking.LightLinks, optional
+        The objects' light sets (light linking); without, none is linked.
     """
 
-    def __init__(self, ctx, materials, view_layer=None):
+    def __init__(self, ctx, materials, view_layer=None, links=None):
         self._ctx = ctx
         self._materials = materials
+        self._links = links
         self._view_layer = view_layer
         self._override = getattr(view_layer, "material_override", None)
         self._layer_flags: dict = {}              # by (question, original object): asked once
@@ -149,6 +153,7 @@ class MeshCollector:
         self._tags: dict[tuple, list] = {}
         self._terminators: dict[tuple, list] = {}
         self._visibility: dict[tuple, list] = {}
+        self._light_sets: dict[tuple, list] = {}    # (receiver set, light sets) per instance
         # Per geometry object, after geometry(): (tag, (first vertex, count), LocalMesh, slots, matrix).
         self.layout: list = []
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
@@ -185,7 +190,7 @@ class MeshCollector:
                 self._note(mesh.tangents_failed, ob.name)
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
             self._passes[key], self._tags[key], self._terminators[key] = [], [], []
-            self._visibility[key] = []
+            self._visibility[key], self._light_sets[key] = [], []
         if self._meshes[key] is not None:
             self._matrices[key].append(np.array(inst.matrix_world, np.float64))
             self._names[key].append(name)
@@ -197,6 +202,9 @@ class MeshCollector:
             self._terminators[key].append((ob.shadow_terminator_geometry_offset,
                                            ob.shadow_terminator_shading_offset))
             self._visibility[key].append(self._ray_visibility(inst))
+            self._light_sets[key].append(
+                (self._links.receiver_set(ob), self._links.light_sets(ob)) if self._links
+                else (0, LIGHT_SETS_ALL))
 
     def geometry(self) -> Geometry:
         """All collected instances as one world-space Geometry (also emits the object notes)."""
@@ -215,6 +223,11 @@ class MeshCollector:
         geometry.object_visibility = np.array(
             [v for key, mesh in self._meshes.items() if mesh is not None
              for v in self._visibility[key]], np.uint8)
+        light_sets = [v for key, mesh in self._meshes.items() if mesh is not None
+                      for v in self._light_sets[key]]
+        if any(v != (0, LIGHT_SETS_ALL) for v in light_sets):
+            geometry.object_receiver_set = np.array([v[0] for v in light_sets], np.uint8)
+            geometry.object_light_sets = np.array([v[1] for v in light_sets], np.uint64)
         # The instances' places in the geometry, in the order _place_all writes them.
         self.layout = []
         first = 0

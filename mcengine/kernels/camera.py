@@ -404,6 +404,7 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.mis_p[n, 3] = st.mis_p[n, 4] = st.mis_p[n, 5] = 0.0
             st.min_pdf[n] = math.inf
             st.self_prim[n] = -1
+            st.mis_set[n] = 0
             st.dp[n], st.dd[n] = camera_differential(sc.camera, x + fx, y + fy)
             st.o32[n, 0], st.o32[n, 1], st.o32[n, 2] = ox, oy, oz
             st.d32[n, 0], st.d32[n, 1], st.d32[n, 2] = dx, dy, dz

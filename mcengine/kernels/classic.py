@@ -178,7 +178,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if lamps_hit:
             passed = light_from_lamps(sc, cfg, fcfg, stats, acc, root, st.beta, i,
                                       ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, PMF_EVERY,
-                                      mp, 0.0, st.transparent[i], direct)
+                                      mp, 0.0, st.transparent[i], direct, -1)
             if passed:
                 st.transparent[i] += passed
                 if st.transparent[i] >= cfg[CFG_MAX_TRANSPARENT]:
@@ -186,7 +186,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         if p < 0:
             acc[root, 3] += light_from_background(sc, cfg, fcfg, scratch, stats, acc, root, st.beta, i,
                                                   dx, dy, dz, flags, mis_pdf, PMF_EVERY,
-                                                  mp, 0.0, direct)
+                                                  mp, 0.0, direct, -1)
             continue
         if sc.tri_area[p] <= 0.0:
             continue

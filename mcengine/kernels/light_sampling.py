@@ -32,6 +32,7 @@ from .intersect import prim_corners, prim_frame
 from .light_tree import sphere_importance, tree_pick, tree_pmf
 from .lights import (
     L_FLAGS,
+    L_LIGHT_SETS,
     L_MAX_BOUNCES,
     L_PMF,
     L_SUN_OMC,
@@ -44,6 +45,7 @@ from .lights import (
     LF_VIS_GLOSSY,
     LF_VIS_TRANSMISSION,
     LT_SUN,
+    in_light_sets,
     intersect_lamp,
     lamp_importance,
     sample_lamp,
@@ -63,7 +65,7 @@ from .state import (
     VIS_GLOSSY,
     VIS_TRANSMISSION,
 )
-from .svm import OBJ_VISIBILITY
+from .svm import OBJ_LIGHT_SETS, OBJ_RECEIVER_SET, OBJ_VISIBILITY
 
 # How a light's selection probability is known, for MIS weights.
 PMF_GLOBAL = 0            # by power, scene-wide (lamps[:, L_PMF], emit_pmf)
@@ -190,6 +192,32 @@ def emitter_exclude(sc, tri):
 
 
 @device
+def receiver_set(sc, tri):
+    """The light set the object of triangle ``tri`` receives (light linking)."""
+    return int(sc.tex.objects[sc.tex.tri_object[tri], OBJ_RECEIVER_SET])
+
+
+@device
+def emitter_lights(sc, tri, light_set):
+    """Whether emissive triangle ``tri`` lights receivers of ``light_set`` (-1: any, no
+    light linking); Cycles' light_link_object_match."""
+    return light_set < 0 or in_light_sets(sc.tex.objects, sc.tex.tri_object[tri], OBJ_LIGHT_SETS,
+                                          light_set)
+
+
+@device
+def light_links(sc, idx, light_set):
+    """Whether next-event estimation's light ``idx`` (a lamp, NL + j for emissive triangle j,
+    or the world after them, which no link restricts) lights receivers of ``light_set``."""
+    n_lamps = sc.lamps.shape[0]
+    if idx < n_lamps:
+        return in_light_sets(sc.lamps, idx, L_LIGHT_SETS, light_set)
+    if idx < n_lamps + sc.emit_tri.shape[0]:
+        return emitter_lights(sc, sc.emit_tri[idx - n_lamps], light_set)
+    return True
+
+
+@device
 def local_light_total(lamps, group, has_group, world, recv):
     """Sum of every light's importance at the receiver (lamps, the emissive triangles as
     one, and the world's constant importance ``world``, 0 when it is not sampled)."""
@@ -245,8 +273,9 @@ def pick_light_local(lamps, group, has_group, world, recv, u):
 
 @device
 def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-                     mp, mis_total, transparent_left):
-    """Light from lamps the ray passes through before t_hit (lamps do not block rays).
+                     mp, mis_total, transparent_left, light_set):
+    """Light from lamps the ray passes through before t_hit (lamps do not block rays), of
+    those that light ``light_set`` (the receiver the ray left; -1: every lamp).
 
     Lamps are visited nearest first; each one counts as a transparent bounce
     (Cycles), at most ``transparent_left`` of them.  MIS weights use the NEE
@@ -266,6 +295,8 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
         br = bg = bb = bpdf = 0.0
         for li in range(n_lamps):
             if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
+                continue
+            if light_set >= 0 and not in_light_sets(lamps, li, L_LIGHT_SETS, light_set):
                 continue
             tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
                                                   mp[0], mp[1], mp[2])
@@ -290,14 +321,17 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
 
 
 @device
-def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total):
-    """Light from suns with an angle, seen along an escaped ray (MIS-weighted)."""
+def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total, light_set):
+    """Light from suns with an angle, seen along an escaped ray (MIS-weighted), of those that
+    light ``light_set`` (-1: every sun)."""
     r = g = b = 0.0
     for li in range(lamps.shape[0]):
         if int(lamps[li, L_TYPE]) != LT_SUN or lamps[li, L_SUN_OMC] <= 0.0:
             continue
         lflags = int(lamps[li, L_FLAGS])
         if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):
+            continue
+        if light_set >= 0 and not in_light_sets(lamps, li, L_LIGHT_SETS, light_set):
             continue
         lr, lg, lb, lpdf = sun_radiance(lamps, li, dx, dy, dz)
         if lpdf > 0.0:

@@ -59,6 +59,7 @@ from .importance import camera_sees, in_film, splat
 from .intersect import SHADOW_SHORTEN, offset_origin
 from .lights import (
     L_FLAGS,
+    L_LIGHT_SETS,
     L_PMF,
     L_RADIUS,
     L_TYPE,
@@ -66,9 +67,11 @@ from .lights import (
     LF_USE_MIS,
     LF_VIS_GLOSSY,
     LF_VIS_TRANSMISSION,
+    LIGHT_SETS_ALL,
     LT_AREA,
     LT_POINT,
     LT_SPOT,
+    light_set_columns,
 )
 from .sampling import SET_BSDF, SET_TERMINATE, bounce_set, mix64, path_key, rand
 from .shading import leaves_correct_side, set_ray, shade_point
@@ -134,7 +137,11 @@ def prepare(scene, sc, cfg, plan) -> tuple:
     flags = lamps[:, L_FLAGS].astype(np.int64)
     point = np.isin(kind, (LT_POINT, LT_SPOT)) & (lamps[:, L_RADIUS] <= 0.0)
     area = (kind == LT_AREA) & ((flags & LF_USE_MIS) != 0) & plan.lamps_hit
-    traced = point | area
+    # A lamp that lights only some objects (light linking) leaves its caustics to path
+    # tracing, which tests the link at the first surface its light reaches.
+    everyone = np.all(lamps[:, L_LIGHT_SETS:L_LIGHT_SETS + 2]
+                      == light_set_columns([LIGHT_SETS_ALL]), axis=1)
+    traced = (point | area) & everyone
     emit_cdf, emit_pmf = emitter_distribution(lamps[:, L_PMF], traced)
     if not emit_cdf[-1] > 0.0:
         return None, []

@@ -70,7 +70,13 @@ L_FLAGS = 36
 L_MAX_BOUNCES = 37
 L_PMF = 38           # probability of picking this lamp for NEE (by power, scene-wide)
 L_IMPORTANCE = 39    # scale of the irradiance estimate that picks lights per shading point
-LIGHT_STRIDE = 40
+L_LIGHT_SETS = 40    # 2: light linking, the receivers' light sets it lights (light_set_columns)
+LIGHT_STRIDE = 42
+
+# Light linking (Blender's light sets, as Cycles reads them): a receiver belongs to one light
+# set (0: the default set of unlinked objects) and an emitter lights a mask of light sets.
+MAX_LIGHT_SETS = 64
+LIGHT_SETS_ALL = (1 << MAX_LIGHT_SETS) - 1
 
 # A light that subtends a cone with 1 - cos(half angle) below this is a delta
 # light (a direction, or a point): its cone would be narrower than 1.4e-7 rad,
@@ -94,6 +100,24 @@ LF_VIS_DIFFUSE = 8
 LF_VIS_GLOSSY = 16
 LF_VIS_TRANSMISSION = 32
 LF_LIGHT_TRACED = 64      # its caustic paths are light tracing's: path tracing's rays leave them
+
+
+def light_set_columns(masks) -> np.ndarray:
+    """(N, 2) float64 of light-set masks (light linking: bit s for light set s, 0..63), as
+    the kernels keep them in a float table: bits 0-31 and bits 32-63, each exact in a float."""
+    masks = np.asarray([int(m) for m in np.ravel(masks)], dtype=object)
+    low = np.array([m & 0xFFFFFFFF for m in masks], np.float64)
+    high = np.array([m >> 32 for m in masks], np.float64)
+    return np.stack([low, high], axis=1).reshape(-1, 2)
+
+
+@device
+def in_light_sets(table, row, column, light_set):
+    """Whether the light-set mask in ``table[row, column:column + 2]`` (``light_set_columns``)
+    holds ``light_set``."""
+    if light_set < 32:
+        return (np.int64(table[row, column]) >> light_set) & 1 != 0
+    return (np.int64(table[row, column + 1]) >> (light_set - 32)) & 1 != 0
 
 
 def _unit(v):
@@ -133,6 +157,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
         flags |= LF_VIS_GLOSSY if li.visible_glossy else 0
         flags |= LF_VIS_TRANSMISSION if li.visible_transmission else 0
         row[L_MAX_BOUNCES] = li.max_bounces
+        row[L_LIGHT_SETS:L_LIGHT_SETS + 2] = light_set_columns([li.light_sets])[0]
         row[L_SPREAD_TAN] = -1.0
         # Negative strengths remove light, as in Cycles; lights are picked by |strength|.
         magnitude = float(np.abs(strength).mean())

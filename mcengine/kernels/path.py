@@ -66,11 +66,14 @@ from .intersect import offset_origin, offset_scale, ray_masks
 from .light_sampling import (
     PMF_GLOBAL,
     PMF_LOCAL,
+    emitter_lights,
+    light_links,
     local_light_total,
     pick_emitter,
     pick_light,
     pick_light_local,
     receiver,
+    receiver_set,
 )
 from .passes import (
     LK_BACKGROUND,
@@ -118,6 +121,7 @@ from .shadows import trace_shadows
 from .state import (
     CFG_CAUSTICS,
     CFG_LAMPS_HIT,
+    CFG_LIGHT_LINKING,
     CFG_LIGHT_TRACING,
     CFG_LIGHTS,
     CFG_LOCAL_LIGHTS,
@@ -201,6 +205,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     max_transparent = cfg[CFG_MAX_TRANSPARENT]
     sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
     walks = cfg[CFG_SUBSURFACE] != 0
+    linking = cfg[CFG_LIGHT_LINKING] != 0
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
@@ -224,6 +229,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # Light-picking probabilities at the vertex this ray left, for MIS.
         mp = (st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2],
               st.mis_p[i, 3], st.mis_p[i, 4], st.mis_p[i, 5])
+        # Light linking: lights found by the ray count if they light the receiver it left
+        # (camera rays, also through transparent surfaces, see every light).
+        ray_set = st.mis_set[i] if linking and not (flags & PF_CAMERA) else -1
         mis_total = 0.0
         if local and mis and not (flags & PF_MIS_SKIP):
             mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, world_importance,
@@ -235,7 +243,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             passed = light_from_lamps(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i,
                                       ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-                                      mp, mis_total, st.transparent[i], direct)
+                                      mp, mis_total, st.transparent[i], direct, ray_set)
             if passed:
                 if light_passes:
                     _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
@@ -252,7 +260,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_BACKGROUND)
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
             light_from_suns(sc, cfg, fcfg, stats, st.radiance, i, st.beta, i, dx, dy, dz, flags,
-                            mis_pdf, pmf_mode, mp, mis_total, direct)
+                            mis_pdf, pmf_mode, mp, mis_total, direct, ray_set)
             if light_passes:
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
             background_passes(pd, fp, st.pixel[i], flags)
@@ -301,8 +309,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                                            + hb * st.beta[i, 2]) / 3.0
                     if hr >= 1.0 and hg >= 1.0 and hb >= 1.0:
                         continue
-            # Emission (two-sided).
-            if emits:
+            # Emission (two-sided), if it lights the receiver the ray left.
+            if emits and emitter_lights(sc, p, ray_set):
                 if light_passes:
                     r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
                 light_from_emitter(sc, fcfg, stats, st.radiance, i, st.beta, i, p,
@@ -363,6 +371,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
+            if linking and not light_links(sc, idx, receiver_set(sc, p)):
+                pmf = 0.0        # the light does not light this object: no sample (Cycles)
             if split:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
                 queued = n_shadow
@@ -409,6 +419,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             st.mis_pdf[i] = ds.pdf
             for c in range(6):
                 st.mis_p[i, c] = recv[c]
+            if linking:
+                st.mis_set[i] = receiver_set(sc, p)
             st.dp[i] = footprint     # Cycles keeps the camera's dD at every bounce
             if ds.pdf > 0.0:
                 st.min_pdf[i] = min(st.min_pdf[i], ds.pdf)

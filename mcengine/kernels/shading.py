@@ -250,15 +250,16 @@ def next_path_flags(flags, label):
 # -- 1-3. light arriving along the ray ---------------------------------------------------------
 @device
 def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy, dz, t_hit,
-                     flags, mis_pdf, pmf_mode, mp, mis_total, transparent, direct):
+                     flags, mis_pdf, pmf_mode, mp, mis_total, transparent, direct, light_set):
     """Add the light of lamps the ray passes before t_hit; returns how many it passed.
 
     Each lamp passed counts as a transparent bounce (Cycles), at most as many
-    as ``transparent`` (the bounces made so far) leaves below the limit.
+    as ``transparent`` (the bounces made so far) leaves below the limit.  Only lamps that
+    light ``light_set`` count (the receiver the ray left, light linking; -1: every lamp).
     """
     lr, lg, lb, passed = lamps_on_segment(
         sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
-        mp, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent)
+        mp, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent, light_set)
     if passed:
         add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg, stats)
     return passed
@@ -266,8 +267,9 @@ def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy
 
 @device
 def light_from_background(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz, flags,
-                          mis_pdf, pmf_mode, mp, mis_total, direct):
-    """Add the world's and the suns' light to an escaped ray.
+                          mis_pdf, pmf_mode, mp, mis_total, direct, light_set):
+    """Add the world's and the suns' light (of the suns that light ``light_set``, -1: all)
+    to an escaped ray.
 
     Returns the film transparency it leaves: on a transparent film a camera
     ray (also through transparent surfaces) sees no background, and the
@@ -276,7 +278,7 @@ def light_from_background(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, 
     transparency = light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, dz,
                                     flags, mis_pdf, pmf_mode, mis_total, direct)
     light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf,
-                    pmf_mode, mp, mis_total, direct)
+                    pmf_mode, mp, mis_total, direct, light_set)
     return transparency
 
 
@@ -307,11 +309,12 @@ def light_from_world(sc, cfg, fcfg, scratch, stats, out, row, beta, i, dx, dy, d
 
 @device
 def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, mis_pdf, pmf_mode,
-                    mp, mis_total, direct):
-    """The suns' part of ``light_from_background``: suns with an angle seen by the ray."""
+                    mp, mis_total, direct, light_set):
+    """The suns' part of ``light_from_background``: suns with an angle seen by the ray (those
+    that light ``light_set``; -1: all)."""
     if sc.lamps.shape[0] and cfg[CFG_LAMPS_HIT]:
         lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
-                               mp, mis_total)
+                               mp, mis_total, light_set)
         if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,
                       stats)

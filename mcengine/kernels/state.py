@@ -37,6 +37,8 @@ PathState = namedtuple("PathState", [
     "mis_p",         # (B, 6) f64    the receiver that ray left: vertex, normal (0: none; light
                      #               picking there, for MIS: light_sampling.receiver)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
+    "mis_set",       # (B,) int32    light set the object at mis_p receives (light linking:
+                     #               Cycles' mis_ray_object; 0 for camera rays)
     "dp",            # (B,) f64      ray differential: footprint at mis_p (Cycles' compact ray dP)
     "dd",            # (B,) f64      its growth per unit length (the camera's compact dD)
     "time",          # (B,) f64      time of the path's camera sample, in [0, 1] over the shutter
@@ -184,7 +186,8 @@ CFG_SOBOL_MASK = 23       # mask of the Sobol sampler's shuffled sample index (s
 CFG_WORLD_SHADER = 24     # the background varies (textures, ray types): run the world's shader
 CFG_LIGHT_TRACING = 25    # light tracing renders the caustics of the LF_LIGHT_TRACED lamps
 CFG_SUBSURFACE = 26       # BSSRDF closures walk inside their objects (else they are Lambert)
-CFG_SIZE = 27
+CFG_LIGHT_LINKING = 27    # some light lights only some objects (light linking's light sets)
+CFG_SIZE = 28
 # Float settings (fcfg array).
 FCFG_CLAMP_DIRECT = 0     # limit on |r|+|g|+|b| of a direct contribution (inf: off)
 FCFG_CLAMP_INDIRECT = 1
@@ -214,6 +217,7 @@ def alloc_path_state(n: int) -> PathState:
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
         mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 6)), self_prim=np.zeros(n, np.int32),
+        mis_set=np.zeros(n, np.int32),
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
         t32=np.zeros(n, np.float32))
@@ -245,6 +249,7 @@ def move_path(st, i, m):
     st.mis_pdf[m] = st.mis_pdf[i]
     st.min_pdf[m] = st.min_pdf[i]
     st.self_prim[m] = st.self_prim[i]
+    st.mis_set[m] = st.mis_set[i]
     st.dp[m] = st.dp[i]
     st.dd[m] = st.dd[i]
     st.time[m] = st.time[i]

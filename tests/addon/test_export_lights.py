@@ -107,20 +107,6 @@ def test_portals_are_skipped_with_a_warning(scene, fake_session):
     assert any(w.startswith("light 'Window' is a light portal") for w in desc.warnings)
 
 
-def test_light_and_shadow_linking_are_warned(scene, fake_session):
-    """Light linking (a light's receiver collection) and shadow linking (its blocker
-    collection) are not rendered: each is named with the lights that use it and the fallback,
-    and a light without them gets no such warning."""
-    linked = bpy.data.collections.new("Receivers")
-    lamp(scene, "POINT", name="Key").light_linking.receiver_collection = linked
-    lamp(scene, "SPOT", name="Rim").light_linking.blocker_collection = linked
-    lamp(scene, "SUN", name="Plain")
-    warnings = export_scene(fake_session).warnings
-    assert "light linking not supported yet ('Key'); their light reaches every object" in warnings
-    assert "shadow linking not supported yet ('Rim'); every object casts their shadows" in warnings
-    assert not [w for w in warnings if "Plain" in w]
-
-
 def test_instanced_lights(scene, fake_session):
     col = bpy.data.collections.new("Lamps")
     lamp(scene, "POINT", name="Bulb", collection=col)

@@ -152,7 +152,7 @@ def test_summary_lists_simulated_and_skipped_effects():
     lights, on, off = line.split(" | ")
     assert lights.startswith("Lights: 1 area, world; surfaces: diffuse, sharp glossy, sharp glass")
     assert "transparent shadows (forced)" in on and "caustic paths" in on
-    assert off == "skipped: subsurface walks"       # no subsurface material
+    assert off == "skipped: subsurface walks, light linking"   # no subsurface, no links
 
 
 def test_unknown_effect_is_refused():

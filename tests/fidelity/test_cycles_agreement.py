@@ -48,8 +48,8 @@ def test_scenes_exist():
             "material_anisotropic", "material_thin_film",
             # holdout objects and collections; true displacement
             "holdout_objects", "material_displacement",
-            # random-walk subsurface scattering; objects' ray visibility
-            "material_subsurface", "ray_visibility"} <= names
+            # random-walk subsurface scattering; objects' ray visibility; light linking
+            "material_subsurface", "ray_visibility", "light_linking"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

@@ -297,3 +297,18 @@ def test_texture_errors_are_caught(renders, name, what, edit):
     result = renders.compare(name, what, edit)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _unlinked(scene):
+    for ob in scene.objects:
+        if ob.light_linking.receiver_collection is not None:
+            ob.light_linking.receiver_collection = None
+
+
+def test_ignored_light_linking_is_caught(renders):
+    """Every light reaching every object (what MC Engine rendered before it honoured light
+    linking): the blue ball in the key light, the rims and the sun on every object, the
+    panel on the red and green balls; blocks differ."""
+    result = renders.compare("light_linking", "every light lights everything", _unlinked)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

@@ -53,7 +53,9 @@ OBJ_TERMINATOR_GEOMETRY = 36  # Shadow Terminator: Geometry Offset (a cosine; 0:
 OBJ_TERMINATOR_SHADING = 37   # and Shading Offset s as Cycles keeps it: 1 / (1 - s / 2)
 OBJ_HOLDOUT = 38              # 1: a holdout object (camera rays reaching it clear the film)
 OBJ_VISIBILITY = 39           # its ray visibility (state.VIS_* bits)
-OBJ_STRIDE = 40
+OBJ_RECEIVER_SET = 40         # light linking: the light set it receives (0: the default set)
+OBJ_LIGHT_SETS = 41           # 2: as an emitter, the light sets it lights (lights.light_set_columns)
+OBJ_STRIDE = 43
 
 # The default UV map's offset in TextureData.attr (always present, 2 components).
 ATTR_DEFAULT_UV = 0

@@ -105,10 +105,9 @@ LF_LIGHT_TRACED = 64      # its caustic paths are light tracing's: path tracing'
 def light_set_columns(masks) -> np.ndarray:
     """(N, 2) float64 of light-set masks (light linking: bit s for light set s, 0..63), as
     the kernels keep them in a float table: bits 0-31 and bits 32-63, each exact in a float."""
-    masks = np.asarray([int(m) for m in np.ravel(masks)], dtype=object)
-    low = np.array([m & 0xFFFFFFFF for m in masks], np.float64)
-    high = np.array([m >> 32 for m in masks], np.float64)
-    return np.stack([low, high], axis=1).reshape(-1, 2)
+    values = masks.ravel().tolist() if isinstance(masks, np.ndarray) else list(masks)
+    return np.array([(int(m) & 0xFFFFFFFF, int(m) >> 32) for m in values],
+                    np.float64).reshape(-1, 2)
 
 
 @device

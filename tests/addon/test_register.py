@@ -43,7 +43,8 @@ def _context(engine, **data):
 def panel_data(scene):
     light = bpy.data.lights.new("Lamp", "AREA")
     return dict(light=light, material=bpy.data.materials.new("Mat"),
-                world=bpy.data.worlds.new("World"), camera=scene.camera.data)
+                world=bpy.data.worlds.new("World"), camera=scene.camera.data,
+                object=bpy.data.objects.new("Obj", bpy.data.meshes.new("Obj")))
 
 
 PANELS = [
@@ -52,6 +53,7 @@ PANELS = [
     "CYCLES_LIGHT_PT_light", "CYCLES_MATERIAL_PT_surface", "CYCLES_WORLD_PT_surface",
     # Blender's panels that Cycles also shows
     "DATA_PT_lens", "DATA_PT_context_light", "RENDER_PT_format", "RENDER_PT_color_management",
+    "OBJECT_PT_shading",       # with its Light Linking and Shadow Linking sub-panels
     # ours
     "MCENGINE_RENDER_PT_engine",
 ]

@@ -80,9 +80,10 @@ def _scene(light=None, *, cover=None, cover_sets=LIGHT_SETS_ALL, sheet=False, sa
     return scene
 
 
-@pytest.mark.parametrize("angle", [0.0, math.radians(10.0)])
+@pytest.mark.parametrize("angle", [0.0, math.radians(10.0)], ids=["delta", "10deg"])
 @pytest.mark.parametrize("sets, expected", [(ONLY_FLOOR, 1.0), (ALL_BUT_FLOOR, 0.0),
-                                            (LIGHT_SETS_ALL, 1.0)])
+                                            (LIGHT_SETS_ALL, 1.0)],
+                         ids=["floor-only", "all-but-floor", "all"])
 def test_a_sun_lights_only_its_light_sets(sets, expected, angle):
     """A sun (a delta one: next-event estimation only; one with an angle: also found by the
     floor's rays, MIS) lights the floor with S / pi when its light sets hold the floor's,
@@ -94,7 +95,8 @@ def test_a_sun_lights_only_its_light_sets(sets, expected, angle):
         assert_mean(s, SUN / math.pi)
 
 
-@pytest.mark.parametrize("sets, expected", [(ONLY_FLOOR, 1.0), (ALL_BUT_FLOOR, 0.0)])
+@pytest.mark.parametrize("sets, expected", [(ONLY_FLOOR, 1.0), (ALL_BUT_FLOOR, 0.0)],
+                         ids=["floor-only", "all-but-floor"])
 def test_an_area_lamp_lights_only_its_light_sets(sets, expected):
     """A large area lamp facing down above the floor: its light reaches the floor through
     both light samples and the rays that hit it (MIS), or, unlinked, through neither."""
@@ -109,7 +111,8 @@ def test_an_area_lamp_lights_only_its_light_sets(sets, expected):
         assert_mean(s, (1.0 / math.pi) * _view_factor(COVER_HALF, COVER_HEIGHT))
 
 
-@pytest.mark.parametrize("sets, expected", [(ONLY_FLOOR, 1.0), (ALL_BUT_FLOOR, 0.0)])
+@pytest.mark.parametrize("sets, expected", [(ONLY_FLOOR, 1.0), (ALL_BUT_FLOOR, 0.0)],
+                         ids=["floor-only", "all-but-floor"])
 def test_an_emissive_object_lights_only_its_light_sets(sets, expected):
     """An emissive cover lights the floor with L F when it links to the floor, and not at
     all otherwise: neither its light samples nor the floor's rays that hit it count."""
@@ -191,3 +194,15 @@ def test_a_linked_lamp_leaves_its_caustics_to_path_tracing():
     assert session.light_tables is None
     direct, _ = mirror_closed_form()
     assert_seeds_mean(images, float(direct.mean()))
+
+
+def test_light_set_masks_are_exact_in_the_float_tables():
+    """Every bit of a 64-bit mask survives the kernels' float table (two 32-bit halves),
+    whether the masks come as Python integers of any size mix or as a uint64 array."""
+    from mcengine.kernels.lights import in_light_sets, light_set_columns
+
+    masks = [LIGHT_SETS_ALL, 1 << 63, (1 << 32) | (1 << 31) | 1, 0, 0xDEADBEEFCAFEF00D]
+    for table in (light_set_columns(masks), light_set_columns(np.array(masks, np.uint64))):
+        for row, mask in enumerate(masks):
+            assert [bool(in_light_sets(table, row, 0, s)) for s in range(64)] == \
+                [bool(mask >> s & 1) for s in range(64)]

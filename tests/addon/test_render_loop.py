@@ -89,7 +89,7 @@ def test_effects_line_is_stored_and_shown_in_the_panel(scene, fake_session, addo
     parts = ["Lights: 1 sun, 1 emissive triangle; surfaces: diffuse, rough glossy, emission; "
              "no textures",
              "simulated: light sampling, lamp hits, MIS weights, caustic paths",
-             "skipped: world lookups, transparent shadows, subsurface walks"]
+             "skipped: world lookups, transparent shadows, subsurface walks, light linking"]
     assert scene.mcengine.last_effects == " | ".join(parts)
     assert scene.mcengine.last_ignored == ""
     assert _panel_text(addon, scene) == [parts[0], "Simulated: " + parts[1][len("simulated: "):],

@@ -30,7 +30,7 @@ def test_f12_renders_with_the_real_core(scene, render_exr):
     assert scene.mcengine.last_effects == (
         "Lights: 2 emissive triangles; surfaces: emission; no textures | simulated: light sampling, "
         "MIS weights | skipped: lamp hits, world lookups, transparent shadows, caustic paths, "
-        "subsurface walks")
+        "subsurface walks, light linking")
 
 
 def test_frames_with_the_same_triangles_reuse_the_bvh(scene, addon):

@@ -166,8 +166,6 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     return ExportResult(scene=desc, ignored=list(ctx.ignored))
 
 
-
-
 def _walk(ctx, depsgraph, meshes: bool = True, shutter=None, vectors: bool = False):
     """One pass over the instances: (geometry, materials, lights, layout); geometry,
     materials and layout (``MeshCollector.layout``, tagged with each instance's motion

@@ -50,6 +50,14 @@ def test_spot_light(scene, fake_session):
     np.testing.assert_allclose(li.matrix_world, np.array(ob.matrix_world), atol=1e-7)
 
 
+def test_square_spot_renders_round_without_a_warning(scene, fake_session):
+    """Cycles ignores Square (an EEVEE setting; its image is the same with it on): so does
+    MC Engine, and it is not a difference to warn of."""
+    lamp(scene, "SPOT", spot_size=0.8, use_square=True)
+    li, warnings = only_light(fake_session)
+    assert li.spot_size == pytest.approx(0.8) and not [w for w in warnings if "square" in w]
+
+
 def test_sun_light(scene, fake_session):
     lamp(scene, "SUN", energy=3.0, angle=math.radians(10))
     li, _ = only_light(fake_session)

@@ -2,8 +2,11 @@
 
 strength = color x energy x 2**exposure, times ``temperature_color`` when
 ``use_temperature`` is on (Blender 5.0 exposes the blackbody colour Cycles
-uses as ``Light.temperature_color``), times the lamp's node tree when it is a
-constant Emission shader (Emission colour x strength; the default is white x 1).
+uses as ``Light.temperature_color``), times the emission of the lamp's node tree when
+that is constant (the default is white x 1): an Emission shader, also with value nodes
+(Blackbody, RGB, Math, ...) and Mix or Add Shaders on constant inputs, compiled and folded
+as a material's graph is (``mcengine.shaders``).  A tree that varies over the lamp (Light
+Falloff, IES Texture, textures on its coordinates) is warned and left out.
 
 Shadow casting is ``light.use_shadow``; MIS and max bounces come from
 ``light.cycles``; the camera/diffuse/glossy/transmission visibility from the
@@ -112,13 +115,34 @@ def _node_factor(ctx, data, name) -> np.ndarray:
     shader = linked_node(out.inputs["Surface"]) if out is not None else None
     if shader is None:
         return np.zeros(3)  # an empty light shader emits nothing in Cycles
+    constant = _constant_emission(ctx, out)
+    if constant is not None:
+        return constant
     what = f"{shader.label or shader.name} shader"
     if shader.bl_idname == "ShaderNodeEmission":
-        color, strength = shader.inputs["Color"], shader.inputs["Strength"]
-        linked = [(linked_node(s), s.name) for s in (color, strength) if linked_node(s) is not None]
-        if not linked:
-            return np.array(color.default_value[:3], np.float64) * strength.default_value
+        linked = [(linked_node(s), s.name) for s in (shader.inputs["Color"], shader.inputs["Strength"])
+                  if linked_node(s) is not None]
         what = ", ".join(f"{src.label or src.name} into Emission '{sock}'" for src, sock in linked)
     ctx.warn(f"light '{name}': light node tree ({what}) not supported yet; rendered without "
              f"its node tree (Emission strength 1)", "light nodes")
     return np.ones(3)
+
+
+def _constant_emission(ctx, out) -> np.ndarray | None:
+    """The emission of a light's output node when its graph folds to constants (None when it
+    varies over the lamp or holds nodes MC Engine does not evaluate)."""
+    from mcengine.kernels.state import MF_EMISSION_VARIES
+    from mcengine.kernels.svm import closures_only
+    from mcengine.scene import Material
+    from mcengine.shaders import ShaderTable
+
+    from .materials import _MaterialGraph
+    graph = _MaterialGraph(ctx)
+    surface = graph.shader(out.inputs["Surface"])
+    if surface is None or graph.items:
+        return None
+    table = ShaderTable([Material(nodes=graph.nodes, surface=surface)])
+    start, end = table.ranges[0]
+    if not closures_only(table.ops[start:end]) or table.flags[0] & MF_EMISSION_VARIES:
+        return None
+    return np.array(table.emission[0], np.float64)

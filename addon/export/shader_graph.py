@@ -97,9 +97,20 @@ def _curve_props(curves: int, combined: bool):
     return props
 
 
+def _output_value_props(name, size):
+    """Props of a node whose value is its output socket's own (RGB, Value): Blender keeps
+    it there, not in a node property."""
+    def props(node, ctx) -> dict:
+        value = node.outputs[0].default_value
+        return {name: tuple(float(v) for v in value[:size]) if size > 1 else float(value)}
+    return props
+
+
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
-# ramps, curves), which the generic property copy cannot.
+# ramps, curves) or sockets (RGB, Value), which the generic property copy cannot.
 SPECIAL_PROPS = {
+    "RGB": _output_value_props("color", 3),
+    "Value": _output_value_props("value", 1),
     "TexCoord": _tex_coord_props,
     "TexImage": _image_props,
     "TexEnvironment": _image_props,

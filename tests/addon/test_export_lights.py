@@ -91,21 +91,60 @@ def test_temperature_colour(scene, fake_session):
 
 
 def test_light_node_tree(scene, fake_session):
+    """A constant node tree is folded into the strength (Emission colour x strength, also
+    from value nodes and shader mixes); one that varies over the lamp is warned and left
+    out."""
     ob = lamp(scene, "POINT", energy=10.0)
     ob.data.use_nodes = True
-    emission = ob.data.node_tree.nodes["Emission"]
+    tree = ob.data.node_tree
+    emission = tree.nodes["Emission"]
     li, warnings = only_light(fake_session)
     assert li.strength == pytest.approx((10, 10, 10)) and not any("light node" in w for w in warnings)
     emission.inputs["Color"].default_value = (0.5, 1, 1, 1)
     emission.inputs["Strength"].default_value = 2.0
     li, _ = only_light(fake_session)
     assert li.strength == pytest.approx((10, 20, 20))
-    blackbody = ob.data.node_tree.nodes.new("ShaderNodeBlackbody")
-    ob.data.node_tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+    rgb = tree.nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (0.5, 0.25, 1.0, 1.0)
+    tree.links.new(rgb.outputs[0], emission.inputs["Color"])
+    times = tree.nodes.new("ShaderNodeMath")
+    times.operation = "MULTIPLY"
+    times.inputs[0].default_value, times.inputs[1].default_value = 3.0, 2.0
+    tree.links.new(times.outputs[0], emission.inputs["Strength"])
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((30, 15, 60)) and not any("light node" in w for w in warnings)
+    # Half of it through a Mix Shader with a Transparent BSDF (which emits nothing).
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.5
+    tree.links.new(emission.outputs[0], mix.inputs[1])
+    tree.links.new(tree.nodes.new("ShaderNodeBsdfTransparent").outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], tree.get_output_node("CYCLES").inputs["Surface"])
+    li, _ = only_light(fake_session)
+    assert li.strength == pytest.approx((15, 7.5, 30))
+    # A Blackbody colour: as the same node gives an emissive material (tested against Cycles).
+    from mcengine.scene import Link, Material, ShaderNode
+    from mcengine.shaders import ShaderTable
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    blackbody.inputs["Temperature"].default_value = 3000.0
+    tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
+    li, _ = only_light(fake_session)
+    same = ShaderTable([Material(nodes=[ShaderNode("Blackbody", {"Temperature": 3000.0}),
+                                        ShaderNode("Emission", {"Color": Link(0, "Color"), "Strength": 1.0})],
+                                 surface=Link(1, "Emission"))]).emission[0]
+    np.testing.assert_allclose(li.strength, 10 * 6 * 0.5 * same, rtol=1e-6)
+    assert not np.allclose(same, same[0])           # a real colour
+    # Varying over the lamp: a texture on its coordinates.
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Fac"], emission.inputs["Strength"])
     li, warnings = only_light(fake_session)
     assert li.strength == pytest.approx((10, 10, 10))
-    assert "light 'Lamp': light node tree (Blackbody into Emission 'Color') not supported yet; " \
-           "rendered without its node tree (Emission strength 1)" in warnings
+    assert ("light 'Lamp': light node tree (Mix Shader shader) not supported yet; rendered "
+            "without its node tree (Emission strength 1)") in warnings
+    tree.links.new(emission.outputs[0], tree.get_output_node("CYCLES").inputs["Surface"])
+    _, warnings = only_light(fake_session)
+    assert ("light 'Lamp': light node tree (Blackbody into Emission 'Color', Noise Texture into "
+            "Emission 'Strength') not supported yet; rendered without its node tree (Emission "
+            "strength 1)") in warnings
 
 
 def test_portals_are_skipped_with_a_warning(scene, fake_session):

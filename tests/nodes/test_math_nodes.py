@@ -220,6 +220,22 @@ def _rgb_to_bw(nt):
     return _node(nt, "RGBToBW", [(0, _colour(nt, (0.0, 0.5, 0.75), (2.0, 0.0, 0.75)))]).outputs[0]
 
 
+def _value_node(nt):
+    """A Value node (its value is its output socket's) added to a sweep."""
+    value = _node(nt, "Value")
+    value.outputs[0].default_value = 0.375
+    return _show_float(nt, _node(nt, "Math", [(0, value.outputs[0]), (1, _sweep(nt, 0, -1.0, 1.0))],
+                                 operation="ADD").outputs[0])
+
+
+def _rgb_node(nt):
+    """An RGB node's colour (its output socket's) times a sweep."""
+    rgb = _node(nt, "RGB")
+    rgb.outputs[0].default_value = (0.25, 0.625, 1.5, 1.0)
+    return _node(nt, "VectorMath", [(0, rgb.outputs[0]), (3, _sweep(nt, 1, 0.5, 2.0))],
+                 operation="SCALE").outputs[0]
+
+
 def _blackbody(lo, hi=None):
     def build(nt):
         t = lo if hi is None else _sweep(nt, 0, lo, hi)
@@ -307,6 +323,7 @@ COLOR_CASES = {
     "combine color HSL": _combine_color("HSL", 0.0, 1.0, 0.4),
     "combine color HSL light": _combine_color("HSL", -0.25, 1.25, 0.8),
     "rgb to bw": _rgb_to_bw,
+    "value node": _value_node, "rgb node": _rgb_node,
     "blackbody cold": _blackbody(300.0, 1600.0), "blackbody warm": _blackbody(1400.0, 4000.0),
     "blackbody hot": _blackbody(3500.0, 14000.0), "blackbody 6500": _blackbody(6500.0),
     "blackbody 0": _blackbody(0.0), "blackbody 1e6": _blackbody(1e6),

@@ -81,9 +81,10 @@ NOISE = {
     "noise detail 15 rough 1": _tex("TexNoise", "Fac", {},
                                     {"Detail": 15.0, "Roughness": 1.0, "Lacunarity": 1.5}),
     "noise roughness 0": _tex("TexNoise", "Fac", {}, {"Roughness": -1.0, "Detail": 4.0}),
-    # Open: the same through the Vector in 2D-4D differs from Cycles by 0.13-0.26 (not
-    # understood yet), so only W (1D) is covered here.
-    "noise huge coordinates 1D": _huge("1D", (0.0, 0.0, 0.0)),
+    # Through the Vector in 2D-4D too (an RGB node's value: it was lost at export, read as
+    # the node's default grey, until the RGB and Value nodes' sockets were read).
+    **{f"noise huge coordinates {d}": _huge(d, (1.3e6, -2.1e6, 0.9e6))
+       for d in ("1D", "2D", "3D", "4D")},
     "noise ridged negative": _tex("TexNoise", "Fac", {"noise_type": "RIDGED_MULTIFRACTAL"},
                                   {"Offset": 0.2, "Gain": 3.0}, vector="Object", strength=-1.0),
     "noise hetero negative": _tex("TexNoise", "Fac", {"noise_type": "HETERO_TERRAIN"},

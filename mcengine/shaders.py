@@ -591,7 +591,8 @@ class ShaderTable:
     of material m's registers in it.  ``emission`` (M, 3) is the radiance the
     material emits as a light source, evaluated as Cycles evaluates a light's
     shader (no closures built, so no layer above the emission darkens it;
-    facing the normal), and ``flags`` (M,) holds MF_* bits: emissive,
+    facing the normal; ``emitted`` the same before negative values are clipped),
+    and ``flags`` (M,) holds MF_* bits: emissive,
     transparent to shadow rays, bump-map correction, closures only, BSSRDF bump.
     """
 
@@ -614,7 +615,7 @@ class ShaderTable:
         self.registers = np.zeros(max(base, 1))
         if init:
             self.registers[np.fromiter(init.keys(), np.int64)] = np.fromiter(init.values(), float)
-        self.emission = np.zeros((len(materials), 3))
+        self.emitted = np.zeros((len(materials), 3))
         self.flags = np.zeros(len(materials), np.int32)
         regs, cl = self.registers.copy(), np.zeros((MAX_CLOSURES, CL_STRIDE))
         point = _HOST_POINT._replace(allocate=False, bump_correction=False)
@@ -622,9 +623,9 @@ class ShaderTable:
             point = point._replace(bump_correction=m.use_bump_map_correction)
             res = eval_shader(self.ops, self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
                               NO_TEXTURES, *NO_MESH)
-            self.emission[i] = np.maximum((res.er, res.eg, res.eb), 0.0)
+            self.emitted[i] = (res.er, res.eg, res.eb)
             flags = MF_BUMP_CORRECTION if m.use_bump_map_correction else 0
-            if self.emission[i].max() > 0.0 or program.emission_varies:
+            if self.emitted[i].max() > 0.0 or program.emission_varies:
                 flags |= MF_EMISSIVE
             if program.emission_varies:
                 flags |= MF_EMISSION_VARIES
@@ -636,6 +637,16 @@ class ShaderTable:
                                              or program.transparency_varies):
                 flags |= MF_TRANSPARENT
             self.flags[i] = flags
+        self.emission = np.maximum(self.emitted, 0.0)
+
+    def constant_emission(self, m: int) -> np.ndarray | None:
+        """Material m's emission when its program folded to constants (a lamp's node tree,
+        whose emission scales the lamp: Cycles evaluates it per light sample, the same
+        everywhere then); None when it varies over the surface."""
+        start, end = self.ranges[m]
+        if not closures_only(self.ops[start:end]) or self.flags[m] & MF_EMISSION_VARIES:
+            return None
+        return self.emitted[m].copy()
 
     def closure_kinds(self, m: int) -> list[int]:
         """Closure node kinds in material m's program."""

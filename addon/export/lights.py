@@ -27,7 +27,7 @@ import numpy as np
 from mcengine.kernels.lights import LIGHT_SETS_ALL
 from mcengine.scene import Light
 
-from .materials import linked_node
+from .materials import linked_node, surface_graph
 
 __all__ = ["export_light"]
 
@@ -131,18 +131,7 @@ def _node_factor(ctx, data, name) -> np.ndarray:
 def _constant_emission(ctx, out) -> np.ndarray | None:
     """The emission of a light's output node when its graph folds to constants (None when it
     varies over the lamp or holds nodes MC Engine does not evaluate)."""
-    from mcengine.kernels.state import MF_EMISSION_VARIES
-    from mcengine.kernels.svm import closures_only
-    from mcengine.scene import Material
     from mcengine.shaders import ShaderTable
 
-    from .materials import _MaterialGraph
-    graph = _MaterialGraph(ctx)
-    surface = graph.shader(out.inputs["Surface"])
-    if surface is None or graph.items:
-        return None
-    table = ShaderTable([Material(nodes=graph.nodes, surface=surface)])
-    start, end = table.ranges[0]
-    if not closures_only(table.ops[start:end]) or table.flags[0] & MF_EMISSION_VARIES:
-        return None
-    return np.array(table.emission[0], np.float64)
+    material = surface_graph(ctx, out.inputs["Surface"])
+    return None if material is None else ShaderTable([material]).constant_emission(0)

@@ -111,6 +111,16 @@ def convert_material(ctx, material) -> Material:
     return result
 
 
+def surface_graph(ctx, socket) -> Material | None:
+    """The shader graph feeding ``socket`` (a lamp's output Surface) as a material of that
+    graph; None when nothing feeds it or it holds nodes MC Engine does not evaluate."""
+    graph = _MaterialGraph(ctx)
+    surface = graph.shader(socket)
+    if surface is None or graph.items:
+        return None
+    return Material(nodes=graph.nodes, surface=surface)
+
+
 def _displacement(graph, material, out):
     """What the output's Displacement receives (a Link, else None): Cycles' bump from
     displacement (method 'BUMP'), true displacement of the mesh ('DISPLACEMENT',

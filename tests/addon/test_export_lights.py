@@ -101,6 +101,9 @@ def test_light_node_tree(scene, fake_session):
     li, warnings = only_light(fake_session)
     assert li.strength == pytest.approx((10, 10, 10)) and not any("light node" in w for w in warnings)
     emission.inputs["Color"].default_value = (0.5, 1, 1, 1)
+    emission.inputs["Strength"].default_value = -2.0            # negative: light removed
+    li, _ = only_light(fake_session)
+    assert li.strength == pytest.approx((-10, -20, -20))
     emission.inputs["Strength"].default_value = 2.0
     li, _ = only_light(fake_session)
     assert li.strength == pytest.approx((10, 20, 20))

@@ -177,6 +177,9 @@ class GraphReader:
     # -- one node ---------------------------------------------------------------------------------
     def convert(self, node, groups) -> ShaderNode:
         kind = node_type(node)
+        if not _identity_mapping(getattr(node, "texture_mapping", None)):
+            self.note(f"{label(node)} Texture Mapping (the node's sidebar)", "texture mapping",
+                      f"{label(node)} read at its unmapped coordinates")
         if kind in SHADER_ROUTING or kind in NODES:
             spec = SHADER_ROUTING.get(kind) or NODES[kind]
             inputs = {}
@@ -248,6 +251,19 @@ class GraphReader:
                       f"{label(node)} rendered as 0.8 grey diffuse")
             return ShaderNode("BsdfDiffuse", {"Color": DEFAULT_GREY}, name=node.name)
         return ShaderNode(kind, {}, name=node.name)
+
+
+def _identity_mapping(mapping) -> bool:
+    """Whether a texture node's legacy Texture Mapping (sidebar > Properties; Cycles applies
+    it, blender/shader.cpp get_tex_mapping) leaves coordinates as they are (or is absent)."""
+    if mapping is None:
+        return True
+    return (tuple(mapping.translation) == (0.0, 0.0, 0.0)
+            and tuple(mapping.rotation) == (0.0, 0.0, 0.0)
+            and tuple(mapping.scale) == (1.0, 1.0, 1.0)
+            and not mapping.use_min and not mapping.use_max
+            and (mapping.mapping_x, mapping.mapping_y, mapping.mapping_z) == ("X", "Y", "Z")
+            and mapping.mapping == "FLAT")
 
 
 def source(socket, groups=()):

@@ -69,6 +69,25 @@ def test_unsupported_texture_into_base_color_gives_exactly_one_warning(scene, fa
     assert "Wireframe node" in scene.mcengine.last_ignored
 
 
+@pytest.mark.parametrize("change", ["translation", "scale", "use_min", "mapping_x", "mapping"])
+def test_a_texture_nodes_texture_mapping_is_warned(scene, fake_session, change):
+    """The legacy Texture Mapping of a texture node (its sidebar; Cycles applies it) is not
+    evaluated: any change from the identity is named, the default is not."""
+    mat = principled("Cloud")
+    tree = mat.node_tree
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Fac"], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    _, warnings = exported(fake_session, mat)
+    assert warnings == []
+    mapping = noise.texture_mapping
+    value = {"translation": (0.5, 0.0, 0.0), "scale": (2.0, 1.0, 1.0), "use_min": True,
+             "mapping_x": "Y", "mapping": "SPHERE"}[change]
+    setattr(mapping, change, value)
+    _, warnings = exported(fake_session, mat)
+    assert warnings == ["material 'Cloud': Noise Texture Texture Mapping (the node's sidebar) not "
+                        "supported yet; Noise Texture read at its unmapped coordinates"]
+
+
 def test_linked_texture_is_copied_with_its_properties(scene, fake_session):
     mat = principled("Tiles")
     tree = mat.node_tree

@@ -45,13 +45,11 @@ def _key(ob):
 class LightLinks:
     """The light sets of a depsgraph's objects: ``receiver_set(ob)`` and ``light_sets(ob)``.
 
-    ``emitters`` are the original objects whose Receiver Collection is set, ``warnings``
-    what could not be linked (one line each)."""
+    ``warnings``: what could not be linked (one line each)."""
 
     def __init__(self, objects):
         collections = {}           # receiver collection (original) -> its bit
         self._emitter_bit = {}     # emitter -> bit of its collection
-        self.emitters = []
         self.warnings = []
         overflow = []
         for ob in objects:
@@ -67,7 +65,6 @@ class LightLinks:
                 overflow.append(ob.name)
                 continue
             self._emitter_bit[_key(ob)] = bit
-            self.emitters.append(ob.original)
         if overflow:
             self.warnings.append(f"light linking: more than {MAX_LIGHT_SETS} receiver "
                                  f"collections; {', '.join(overflow)} light every object")

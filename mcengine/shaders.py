@@ -155,6 +155,15 @@ class AttributeLayout:
         return self.offsets.get(name, (-1, 0))
 
 
+def _known_outputs(node, values) -> dict:
+    """Outputs of a node that does not fold whose value is known anyway: a Light Falloff
+    without Smooth gives its Strength as Quadratic at every ray length (so that a lamp's node
+    tree "Light Falloff > Quadratic" of a constant Strength folds and scales the lamp)."""
+    if node.type == "LightFalloff" and values[1].constant and values[1].const[0] <= 0.0:
+        return {"Quadratic": values[0]}
+    return {}
+
+
 @dataclass
 class Value:
     """A socket's value at compile time: constants, or registers filled at run time."""
@@ -454,6 +463,9 @@ class _Compiler:
             values[names.index("prop:undisplaced")] = Value(FLOAT, (float(offset),))
         if spec.pure and all(v.constant for v in values):
             return self.fold(spec, values)
+        known = _known_outputs(node, values)
+        if known and all(o.name in known or not self.is_linked(node, o.name) for o in spec.outputs):
+            return known
         base = self.block(spec.inputs, values)
         out = self.program.reg(sum(SIZE[s.type] for s in spec.outputs))
         self.program.ops.append([OP_NODE, spec.code, base, out])
@@ -461,6 +473,7 @@ class _Compiler:
         for socket in spec.outputs:
             outputs[socket.name] = Value(socket.type, reg=k)
             k += SIZE[socket.type]
+        outputs.update(known)
         if node.type == "NewGeometry":
             for name, attribute in GEOMETRY_ATTRIBUTES.items():
                 if self.is_linked(node, name):

@@ -158,6 +158,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     desc.images = _images_used(desc, {**(old.images if old is not None else {}), **ctx.images})
     if shutter is not None and layout is not None:
         desc.motion_blur = _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam)
+        motion.warn_moving_wireframes(ctx, desc)
     desc.passes.motion_blur = shutter is not None
     if vectors is not None and layout is not None and "Vector" in desc.passes.enabled:
         desc.motion_vectors = _export_motion_vectors(ctx, depsgraph, frame_set, vectors, layout,
@@ -295,12 +296,11 @@ def _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam):
 
 def _export_motion_vectors(ctx, depsgraph, frame_set, vectors, layout, cam) -> MotionVectors:
     """The objects and the camera at the previous and the next frame, for the Vector pass."""
-    from . import camera
+    from . import camera, motion
 
     moving, camera_steps, camera_matrices, view_sizes, size = _sample_layout(
         ctx, depsgraph, frame_set, vectors, layout)
-    out = MotionVectors(objects=[om for om in moving if om.positions is not None or not all(
-        np.array_equal(m, om.matrices[1]) for m in om.matrices)])
+    out = MotionVectors(objects=[om for om in moving if motion.moves(om)])
     if camera_steps:
         out.camera = np.stack([camera.without_scale(camera_matrices[t], ctx.unit_scale)
                                for t in (-1.0, 1.0)])

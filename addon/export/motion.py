@@ -207,6 +207,28 @@ def sample_motion(ctx, depsgraph, frame_set, shutter_: Shutter, objects, camera_
         camera_matrices, view_sizes
 
 
+def moves(om: ObjectMotion) -> bool:
+    """Whether an object with motion settings moves or deforms over its steps."""
+    return om.positions is not None or not all(np.array_equal(m, om.matrices[0]) for m in om.matrices)
+
+
+def warn_moving_wireframes(ctx, desc) -> None:
+    """Warn when moving objects use a material with a Wireframe node: its edges are their
+    triangles' at the frame's time (the evaluator reads the frame's vertices), where Cycles
+    takes them at each ray's time."""
+    wired = {k for k, m in enumerate(desc.materials) if any(n.type == "Wireframe" for n in m.nodes)}
+    if not wired or desc.motion_blur is None:
+        return
+    g = desc.geometry
+    names = [g.object_names[om.object] for om in desc.motion_blur.objects if moves(om)
+             and wired & set(np.unique(g.material_index[g.object_index == om.object]).tolist())]
+    if names:
+        from .mesh import listed
+        ctx.warn(f"Wireframe on moving objects ({listed(names)}): the edges of their triangles as "
+                 f"they are at the frame, not as they move during the shutter",
+                 "Wireframe under motion blur")
+
+
 def key_name(key) -> str:
     return f"{key[1]}/{key[0]}" if key[1] else key[0]
 

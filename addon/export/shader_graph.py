@@ -98,7 +98,7 @@ def _curve_props(curves: int, combined: bool):
 
 
 def _output_value_props(name, size):
-    """Props of a node whose value is its output socket's own (RGB, Value): Blender keeps
+    """Props of a node whose value is its output socket's own (RGB, Value, Normal): Blender keeps
     it there, not in a node property."""
     def props(node, ctx) -> dict:
         value = node.outputs[0].default_value
@@ -107,10 +107,11 @@ def _output_value_props(name, size):
 
 
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
-# ramps, curves) or sockets (RGB, Value), which the generic property copy cannot.
+# ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
 SPECIAL_PROPS = {
     "RGB": _output_value_props("color", 3),
     "Value": _output_value_props("value", 1),
+    "Normal": _output_value_props("direction", 3),
     "TexCoord": _tex_coord_props,
     "TexImage": _image_props,
     "TexEnvironment": _image_props,

@@ -198,6 +198,12 @@ def receiver_set(sc, tri):
 
 
 @device
+def lamp_lights(lamps, li, light_set):
+    """Whether lamp ``li`` lights receivers of ``light_set`` (-1: any, no light linking)."""
+    return light_set < 0 or in_light_sets(lamps, li, L_LIGHT_SETS, light_set)
+
+
+@device
 def emitter_lights(sc, tri, light_set):
     """Whether emissive triangle ``tri`` lights receivers of ``light_set`` (-1: any, no
     light linking); Cycles' light_link_object_match."""
@@ -211,7 +217,7 @@ def light_links(sc, idx, light_set):
     or the world after them, which no link restricts) lights receivers of ``light_set``."""
     n_lamps = sc.lamps.shape[0]
     if idx < n_lamps:
-        return in_light_sets(sc.lamps, idx, L_LIGHT_SETS, light_set)
+        return lamp_lights(sc.lamps, idx, light_set)
     if idx < n_lamps + sc.emit_tri.shape[0]:
         return emitter_lights(sc, sc.emit_tri[idx - n_lamps], light_set)
     return True
@@ -296,7 +302,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
         for li in range(n_lamps):
             if not lamp_visible_to_ray(flags, int(lamps[li, L_FLAGS])):
                 continue
-            if light_set >= 0 and not in_light_sets(lamps, li, L_LIGHT_SETS, light_set):
+            if not lamp_lights(lamps, li, light_set):
                 continue
             tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
                                                   mp[0], mp[1], mp[2])
@@ -331,7 +337,7 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total, light_
         lflags = int(lamps[li, L_FLAGS])
         if not (lflags & LF_USE_MIS) or not lamp_visible_to_ray(flags, lflags):
             continue
-        if light_set >= 0 and not in_light_sets(lamps, li, L_LIGHT_SETS, light_set):
+        if not lamp_lights(lamps, li, light_set):
             continue
         lr, lg, lb, lpdf = sun_radiance(lamps, li, dx, dy, dz)
         if lpdf > 0.0:

@@ -354,6 +354,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # which a displacement bump has moved); the next ray keeps it for the MIS weights of
         # the light it finds.
         recv = (sp.hx, sp.hy, sp.hz, 0.0, 0.0, 0.0)
+        recv_set = receiver_set(sc, p) if linking else -1     # light linking: its light set
         if local:
             rnx, rny, rnz = shader_normal(sc, scratch.regs, sp)
             recv = receiver(sp.hx, sp.hy, sp.hz, rnx, rny, rnz, scratch.cl, ncl)
@@ -371,7 +372,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             else:
                 idx = pick_light(sc.light_cdf, u_pick)
                 pmf = sc.light_cdf[idx + 1] - sc.light_cdf[idx]
-            if linking and not light_links(sc, idx, receiver_set(sc, p)):
+            if linking and not light_links(sc, idx, recv_set):
                 pmf = 0.0        # the light does not light this object: no sample (Cycles)
             if split:
                 r0, g0, b0 = st.radiance[i, 0], st.radiance[i, 1], st.radiance[i, 2]
@@ -420,7 +421,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             for c in range(6):
                 st.mis_p[i, c] = recv[c]
             if linking:
-                st.mis_set[i] = receiver_set(sc, p)
+                st.mis_set[i] = recv_set
             st.dp[i] = footprint     # Cycles keeps the camera's dD at every bounce
             if ds.pdf > 0.0:
                 st.min_pdf[i] = min(st.min_pdf[i], ds.pdf)

@@ -150,6 +150,29 @@ def test_light_node_tree(scene, fake_session):
             "strength 1)") in warnings
 
 
+def test_light_falloff_in_a_lamp_tree(scene, fake_session):
+    """Light Falloff's Quadratic without Smooth is its Strength at every distance (Cycles'
+    svm_node_light_falloff): the tree folds and scales the lamp.  With Smooth, or through
+    Linear or Constant, it varies over the lamp: warned and left out."""
+    ob = lamp(scene, "SPOT", energy=10.0)
+    ob.data.use_nodes = True
+    tree = ob.data.node_tree
+    falloff = tree.nodes.new("ShaderNodeLightFalloff")
+    falloff.inputs["Strength"].default_value = 25.0
+    tree.links.new(falloff.outputs["Quadratic"], tree.nodes["Emission"].inputs["Strength"])
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((250, 250, 250)) and not any("light node" in w for w in warnings)
+    falloff.inputs["Smooth"].default_value = 0.5
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((10, 10, 10))
+    assert any("light node tree (Light Falloff into Emission 'Strength')" in w for w in warnings)
+    falloff.inputs["Smooth"].default_value = 0.0
+    tree.links.new(falloff.outputs["Linear"], tree.nodes["Emission"].inputs["Strength"])
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((10, 10, 10))
+    assert any("light node tree (Light Falloff into Emission 'Strength')" in w for w in warnings)
+
+
 def test_portals_are_skipped_with_a_warning(scene, fake_session):
     lamp(scene, "AREA", name="Window").data.cycles.is_portal = True
     desc = export_scene(fake_session)

@@ -200,3 +200,33 @@ def test_vector_pass_keeps_deformation(scene, fake_session):
     (om,) = export_scene(fake_session).motion_vectors.objects
     heights = [_at(scene, t, lambda: key.value) for t in (0.0, 1.0, 2.0)]
     np.testing.assert_allclose(om.positions[:, :, 2], np.repeat(heights, 4).reshape(3, 4), atol=1e-5)
+
+
+def _wireframe_material(name):
+    import bpy
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    wire = nt.nodes.new("ShaderNodeWireframe")
+    nt.links.new(wire.outputs["Fac"], nt.nodes["Principled BSDF"].inputs["Roughness"])
+    return mat
+
+
+def test_wireframe_on_a_moving_object_is_warned(scene, fake_session):
+    """The Wireframe node reads the frame's triangles: on an object that moves during the
+    shutter that differs from Cycles (which reads them at the ray's time), and is warned; on
+    one that stays, or without motion blur, it is exact and not warned."""
+    ob = _sliding_square(scene)
+    still = new_mesh_object("Still", SQUARE, [(0, 1, 2, 3)])
+    wire = _wireframe_material("Wire")
+    still.data.materials.append(wire)
+    _motion_blur(scene)
+
+    def warned():
+        return [w for w in export_scene(fake_session).warnings if w.startswith("Wireframe")]
+    assert warned() == []
+    ob.data.materials.append(wire)
+    assert warned() == ["Wireframe on moving objects ('Slider'): the edges of their triangles as "
+                        "they are at the frame, not as they move during the shutter"]
+    scene.render.use_motion_blur = False
+    assert warned() == []

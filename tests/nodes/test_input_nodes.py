@@ -1,6 +1,7 @@
 """Input nodes against Cycles: Texture Coordinate, UV Map, Attribute, Geometry, Tangent, Color
-Attribute, Fresnel, Layer Weight, Object Info, Camera Data and Light Path (as camera rays see it;
-tests/nodes/test_light_path.py follows it through light transport) (harness.py)."""
+Attribute, Fresnel, Layer Weight, Object Info, Camera Data, Light Path (as camera rays see it;
+tests/nodes/test_light_path.py follows it through light transport), Light Falloff and
+Wireframe (harness.py)."""
 
 import math
 
@@ -193,6 +194,39 @@ def _light_path(output):
     return lambda nt: nt.nodes.new("ShaderNodeLightPath").outputs[output]
 
 
+def _light_falloff(output, strength, smooth=0.0):
+    def build(nt):
+        node = nt.nodes.new("ShaderNodeLightFalloff")
+        node.inputs["Strength"].default_value = strength
+        node.inputs["Smooth"].default_value = smooth
+        return node.outputs[output]
+    return build
+
+
+def _wireframe(size, pixel_size=False):
+    def build(nt):
+        node = nt.nodes.new("ShaderNodeWireframe")
+        node.use_pixel_size = pixel_size
+        node.inputs["Size"].default_value = size
+        return node.outputs["Fac"]
+    return build
+
+
+def _grid(ob, cuts=1, tilt=False):
+    """The plane cut into a grid of quads (each two triangles), turned; with ``tilt`` its
+    vertices raised unevenly, so that the camera sees its triangles at different slants."""
+    import bmesh
+    bm = bmesh.new()
+    bm.from_mesh(ob.data)
+    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=cuts, use_grid_fill=True)
+    if tilt:
+        for v, z in zip(bm.verts, np.random.default_rng(3).uniform(-0.2, 0.2, len(bm.verts))):
+            v.co.z += z
+    bm.to_mesh(ob.data)
+    bm.free()
+    _rotated(ob)
+
+
 LIGHT_PATH = ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ray", "Is Singular Ray",
               "Is Reflection Ray", "Is Transmission Ray", "Is Volume Scatter Ray", "Ray Length",
               "Ray Depth", "Diffuse Depth", "Glossy Depth", "Transparent Depth",
@@ -247,6 +281,14 @@ CASES = {
     **{f"camera data {o}": (_camera_data(o), _rotated)
        for o in ("View Vector", "View Z Depth", "View Distance")},
     **{f"light path {o}": _light_path(o) for o in LIGHT_PATH},
+    # the ray length runs from about 9.5 to 10.5 over the tilted plane
+    **{f"light falloff {o} smooth {smooth}": (_light_falloff(o, strength, smooth), _tilted)
+       for o, strength in (("Quadratic", 0.6), ("Linear", 0.06), ("Constant", 0.006))
+       for smooth in (0.0, 60.0)},
+    "wireframe size 0.06": (_wireframe(0.06), _grid),
+    "wireframe size 0.08 tilted": (_wireframe(0.08), lambda ob: _grid(ob, 2, tilt=True)),
+    "wireframe pixel size 1": (_wireframe(1.0, pixel_size=True), _grid),
+    "wireframe pixel size 1.5 tilted": (_wireframe(1.5, pixel_size=True), lambda ob: _grid(ob, 2, tilt=True)),
 }
 
 # Outputs that are 0 everywhere on a plane seen by a camera ray, or by definition (IOR 1 and
@@ -269,4 +311,9 @@ def test_input_node_agrees_with_cycles(images, name):
     # Measured: 4.6e-6 at most, but where a tangent lies nearly along the normal: Cycles
     # projects it (N x normalize(T x N)) in float32, and the cross product cancels.
     loose = name.startswith("tangent radial")      # measured there: 5e-5 at most
-    assert_agree(name, ref, ours, rel=1e-4, abs_tol=1e-4 if loose else 1e-5)
+    # Wireframe is 0 or 1: a pixel centre within rounding of a line's border may differ
+    edges = 0.0
+    if name.startswith("wireframe"):
+        edges = 0.01
+        assert 0.1 < ref.mean() < 0.7, "the lines cover part of the plane"
+    assert_agree(name, ref, ours, rel=1e-4, abs_tol=1e-4 if loose else 1e-5, edge_fraction=edges)

@@ -236,6 +236,21 @@ def _rgb_node(nt):
                  operation="SCALE").outputs[0]
 
 
+def _normal_node(output, direction, linked=True, negate=False):
+    """A Normal node with its vector (kept in its output socket) set to ``direction`` (not
+    of unit length: Cycles normalises it), the Normal input a vector stepping over the plane
+    (or its unlinked (0, 0, 1)); its Dot shown with its negative part, or its Normal."""
+    def build(nt):
+        node = _node(nt, "Normal")
+        node.outputs["Normal"].default_value = direction
+        if linked:
+            nt.links.new(_vsweep(nt, (2.0, -1.5, 0.0), (-1.0, 0.75, 0.25)), node.inputs["Normal"])
+        if output == "Dot":
+            return _show_float(nt, node.outputs["Dot"])
+        return _show_vector(nt, node.outputs["Normal"], negate)
+    return build
+
+
 def _blackbody(lo, hi=None):
     def build(nt):
         t = lo if hi is None else _sweep(nt, 0, lo, hi)
@@ -324,6 +339,10 @@ COLOR_CASES = {
     "combine color HSL light": _combine_color("HSL", -0.25, 1.25, 0.8),
     "rgb to bw": _rgb_to_bw,
     "value node": _value_node, "rgb node": _rgb_node,
+    "normal node dot": _normal_node("Dot", (0.5, -1.0, 1.25)),
+    "normal node dot unlinked": _normal_node("Dot", (0.5, -1.0, 1.25), linked=False),
+    "normal node normal": _normal_node("Normal", (0.5, -1.0, 1.25)),
+    "normal node normal -": _normal_node("Normal", (0.5, -1.0, 1.25), negate=True),
     "blackbody cold": _blackbody(300.0, 1600.0), "blackbody warm": _blackbody(1400.0, 4000.0),
     "blackbody hot": _blackbody(3500.0, 14000.0), "blackbody 6500": _blackbody(6500.0),
     "blackbody 0": _blackbody(0.0), "blackbody 1e6": _blackbody(1e6),

@@ -1,5 +1,5 @@
 """Procedural texture nodes against Cycles (harness.py): Noise, Voronoi, White Noise, Gradient,
-Wave, Brick, Magic, every dimension, type, metric, feature, output and option.
+Wave, Brick, Magic, Gabor, every dimension, type, metric, feature, output and option.
 
 Patterns are compared at the pixel centres of flat emissive planes.  The
 vector input is the plane's Generated coordinate (the default) or its Object
@@ -187,6 +187,18 @@ OTHERS = {
        for n in (0, 1, 2, 3, 5, 8, 10)},
     "magic fac": _tex("TexMagic", "Fac", {"turbulence_depth": 4}),
     "magic no distortion": _tex("TexMagic", "Color", {}, {"Distortion": 0.0, "Scale": 2.0}),
+    **{f"gabor {t} {o}": _tex("TexGabor", o, {"gabor_type": t}, vector="Object")
+       for t in ("2D", "3D") for o in ("Value", "Phase", "Intensity")},
+    "gabor 2D anisotropic": _tex("TexGabor", "Value", {"gabor_type": "2D"},
+                                 {"Anisotropy": 0.8, "Orientation 2D": -0.6, "Frequency": 3.5,
+                                  "Scale": 3.0}),
+    "gabor 2D isotropic": _tex("TexGabor", "Intensity", {"gabor_type": "2D"},
+                               {"Anisotropy": 0.0, "Frequency": 0.5, "Scale": 8.0}),
+    "gabor 3D anisotropic": (_tex("TexGabor", "Value", {"gabor_type": "3D"},
+                                  {"Anisotropy": 0.7, "Orientation 3D": (0.2, -1.0, 0.6),
+                                   "Frequency": 3.0, "Scale": 2.5}, vector="Position"), _turned),
+    "gabor 3D along z": _tex("TexGabor", "Value", {"gabor_type": "3D"},
+                             {"Anisotropy": 0.0, "Orientation 3D": (0.3, 0.0, 2.0)}),
 }
 
 CASES = {**NOISE, **VORONOI, **OTHERS}

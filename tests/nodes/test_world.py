@@ -96,6 +96,18 @@ def _add_emission(nt, out):
     nt.links.new(add.outputs["Shader"], out.inputs["Surface"])
 
 
+def _falloff_strength(nt, out):
+    """A Light Falloff between a texture and the Background's Strength: the world's ray
+    length is FLT_MAX, at which every output is the Strength itself (Linear, not infinity)."""
+    bg = _background(nt)
+    bg.inputs["Color"].default_value = (0.2, 0.5, 0.9, 1.0)
+    falloff = nt.nodes.new("ShaderNodeLightFalloff")
+    falloff.inputs["Smooth"].default_value = 0.5
+    nt.links.new(_env(nt).outputs["Color"], falloff.inputs["Strength"])
+    nt.links.new(falloff.outputs["Linear"], bg.inputs["Strength"])
+    nt.links.new(bg.outputs["Background"], out.inputs["Surface"])
+
+
 def _generated_vector(nt, out):
     env = _env(nt)
     nt.links.new(nt.nodes.new("ShaderNodeTexCoord").outputs["Generated"], env.inputs["Vector"])
@@ -153,6 +165,7 @@ CASES = {
     "mix of two backgrounds": _mix,
     "background plus emission": _add_emission,
     "generated coordinates are the direction": _generated_vector,
+    "light falloff passes the strength through": _falloff_strength,
     **SKY_CASES,
 }
 

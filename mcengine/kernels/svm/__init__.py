@@ -80,10 +80,14 @@ from .nodes import (
     FAMILY_TEXTURE,
     FAMILY_VECTOR,
     IMAGE_CODES,
+    NODES,
 )
 from .normal_nodes import eval_normal_node
 from .texture_nodes import eval_texture_node
 from .vector_nodes import eval_vector_node
+from .wireframe import wireframe_node
+
+_WIREFRAME = NODES["Wireframe"].code
 
 OP_END = 0
 OP_NODE = 1
@@ -150,12 +154,15 @@ def convert(regs, a, b, kind):
 
 
 @device
-def eval_row(ops, pc, regs, sd, tex):
+def eval_row(ops, pc, regs, sd, tex, verts, tris):
     """One value row: OP_NODE, OP_COPY or OP_CONVERT."""
     op = ops[pc, 0]
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if op == OP_NODE:
-        eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
+        if a == _WIREFRAME:         # the one node that reads the triangle's corners
+            wireframe_node(regs, b, c, sd, verts, tris)
+        else:
+            eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
     elif op == OP_COPY:
         for k in range(c):
             regs[a + k] = regs[b + k]
@@ -175,7 +182,7 @@ def eval_values(ops, start, end, regs, sd, tex, verts, tris):
             else:
                 point = region_point(ops, pc, regs, sd, tex, verts, tris)
         else:
-            eval_row(ops, pc, regs, point, tex)
+            eval_row(ops, pc, regs, point, tex, verts, tris)
 
 
 @device
@@ -210,7 +217,7 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
                         region_point(ops, pc, regs, sd, tex, verts, tris), tex, verts, tris)
             skip = pc + ops[pc, 3] + 1
         else:
-            eval_row(ops, pc, regs, sd, tex)
+            eval_row(ops, pc, regs, sd, tex, verts, tris)
     return res
 
 

@@ -2,9 +2,9 @@
 attribute.h, vertex_color.h, fresnel.h, light_path.h, camera.h, value.h).
 
 Texture Coordinate, UV Map, Attribute, Color Attribute, Geometry, Tangent, Object
-Info, Camera Data, Fresnel, Layer Weight and Light Path read the point
+Info, Camera Data, Fresnel, Layer Weight, Light Path and Light Falloff read the point
 (``ShadingData``: its path flags, ray length and bounce counts for Light
-Path) and the scene's per-corner attributes and per-object data
+Path, the ray length for Light Falloff) and the scene's per-corner attributes and per-object data
 (``TextureData``); Value and RGB are constants (the compiler folds them, so
 they only run here when evaluated ahead of time).  Every output of a node is
 computed, each into its registers (``nodes.OUTPUT_OFFSETS``).
@@ -27,7 +27,7 @@ from .data import (
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
 )
-from .math_nodes import safe_normalize
+from .math_nodes import FLT_MAX, safe_normalize
 from .nodes import AXIS_X, AXIS_Y, AXIS_Z, DIRECTION_UV_MAP, NODES, OFFSETS
 
 _VALUE = NODES["Value"].code
@@ -59,6 +59,8 @@ _TANGENT = NODES["Tangent"].code
 _TG_DIRECTION = OFFSETS["Tangent"]["prop:direction_type"]
 _TG_AXIS = OFFSETS["Tangent"]["prop:axis"]
 _TG_ATTRIBUTE = OFFSETS["Tangent"]["prop:attribute"]
+_LIGHT_FALLOFF = NODES["LightFalloff"].code
+_LF_SMOOTH = OFFSETS["LightFalloff"]["Smooth"]
 _RANDOM_SCALE = 1.0 / 4294967295.0       # Object Info Random: the object's 32-bit random id
 
 
@@ -80,6 +82,8 @@ def eval_input_node(code, regs, b, c, sd, tex):
         fresnel_nodes(code, regs, b, c, sd)
     elif code == _LIGHT_PATH:
         light_path(regs, c, sd)
+    elif code == _LIGHT_FALLOFF:
+        light_falloff(regs, b, c, sd)
     elif code == _OBJECT_INFO:
         object_info(regs, b, c, sd, tex)
     elif code == _CAMERA_DATA:
@@ -369,6 +373,26 @@ def light_path(regs, c, sd):
     regs[c + 12] = sd.transparent_depth
     regs[c + 13] = sd.transmission_depth
     regs[c + 14] = 0.0                      # portals: none
+
+
+@device
+def light_falloff(regs, b, c, sd):
+    """Light Falloff (svm_node_light_falloff): Strength as it is (Quadratic), times the ray
+    length (Linear), times its square (Constant), each times t^2 / (Smooth + t^2) when
+    Smooth > 0; Strength alone on every output for a distant light or the world (a ray
+    length of FLT_MAX or more)."""
+    strength = regs[b]
+    t = sd.ray_length
+    if t >= FLT_MAX:
+        regs[c] = regs[c + 1] = regs[c + 2] = strength
+        return
+    smooth = regs[b + _LF_SMOOTH]
+    f = 1.0
+    if smooth > 0.0:
+        f = t * t / (smooth + t * t)
+    regs[c] = strength * f
+    regs[c + 1] = strength * t * f
+    regs[c + 2] = strength * t * t * f
 
 
 @device

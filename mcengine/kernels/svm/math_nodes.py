@@ -29,6 +29,8 @@ from .nodes import (
     OUTPUT_OFFSETS,
 )
 
+FLT_MAX = 3.4028234663852886e38      # the largest float32 (Cycles' FLT_MAX)
+
 _MATH = NODES["Math"].code
 _VECTOR_MATH = NODES["VectorMath"].code
 _MAP_RANGE = NODES["MapRange"].code

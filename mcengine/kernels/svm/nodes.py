@@ -23,6 +23,7 @@ module of this package (``FAMILY_*``).
 """
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 
 from ..closures.layout import SSS_BURLEY, SSS_RANDOM_WALK, SSS_RANDOM_WALK_SKIN
@@ -216,6 +217,7 @@ ENUMS = {
     "noise_dimensions": DIMENSIONS,
     "noise_type": NOISE_TYPES,
     "voronoi_dimensions": DIMENSIONS,
+    "gabor_type": DIMENSIONS,
     "feature": VORONOI_FEATURES,
     "distance": VORONOI_METRICS,
     "gradient_type": GRADIENT_TYPES,
@@ -345,13 +347,14 @@ SHADER_ROUTING = {
 }
 
 # -- value nodes: families ------------------------------------------------------------------------
-FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, constants
+FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, constants;
+                       # svm/wireframe.py: Wireframe
 FAMILY_MATH = 2        # svm/math_nodes.py: Math, Vector Math, Map Range, converters
 FAMILY_COLOR = 3       # svm/color_nodes.py: Mix, ColorRamp, curves, colour adjustments
 FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural textures (401-449);
                        # svm/image_nodes.py: image textures (450-469)
 IMAGE_CODES = 450      # first code of the image nodes
-FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Transform
+FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Rotate, Vector Transform, Normal
 FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump
 
 # Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
@@ -393,6 +396,11 @@ VALUE_NODES = {
     # Tangent: "prop:attribute" is the UV map's tangent attribute (TANGENT_PREFIX)
     "Tangent": NodeSpec(113, (_p("direction_type", DIRECTION_RADIAL), _p("axis", AXIS_Z),
                               _p("attribute", -1)), (_v("Tangent", UNLINKED),), False),
+    "LightFalloff": NodeSpec(114, (_f("Strength", 100.0), _f("Smooth", 0.0)),
+                             (_f("Quadratic", 0.0), _f("Linear", 0.0), _f("Constant", 0.0)), False),
+    # Wireframe reads the point's triangle (evaluated by ``svm.wireframe``, not by its family)
+    "Wireframe": NodeSpec(115, (_f("Size", 0.01), _p("use_pixel_size", 0)), (_f("Fac", 0.0),),
+                          False),
     # -- math family: converters (svm/math_nodes.py)
     "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
                            _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),
@@ -479,6 +487,11 @@ VALUE_NODES = {
     "TexMagic": NodeSpec(408, (_v("Vector", GENERATED), _f("Scale", 5.0), _f("Distortion", 1.0),
                                _p("turbulence_depth", 2)),
                          (_c("Color", (0, 0, 0)), _f("Fac", 0.0)), True),
+    "TexGabor": NodeSpec(409, (_v("Vector", GENERATED), _f("Scale", 5.0), _f("Frequency", 2.0),
+                               _f("Anisotropy", 1.0), _f("Orientation 2D", math.pi / 4.0),
+                               _v("Orientation 3D", (math.sqrt(2.0), math.sqrt(2.0), 0.0)),
+                               _p("gabor_type", 2)),
+                         (_f("Value", 0.0), _f("Phase", 0.0), _f("Intensity", 0.0)), True),
     # Images (svm/image_nodes.py, codes 450-469).  "prop:image" is the image's slot in the
     # render's image table (the compiler finds the node's image by name; -1: missing, magenta);
     # "prop:alpha_linked" is 1 when the Alpha output is used (Cycles then divides the colour
@@ -514,6 +527,9 @@ VALUE_NODES = {
                                       _p("convert_from", TRANSFORM_SPACES["WORLD"]),
                                       _p("convert_to", TRANSFORM_SPACES["OBJECT"])),
                                 (_v("Vector"),), False),
+    # Normal: "prop:direction" is the node's vector, which Blender keeps in its output socket
+    "Normal": NodeSpec(504, (_v("Normal", (0.0, 0.0, 1.0)), Socket("prop:direction", VECTOR, (0.0, 0.0, 1.0))),
+                       (_v("Normal"), _f("Dot", 0.0)), True),
     # -- normal family ("prop:attribute": the tangent attribute "tangent:<uv map>", see
     #    TANGENT_PREFIX; its 4 components are the MikkTSpace tangent and sign, object space)
     "NormalMap": NodeSpec(601, (_f("Strength", 1.0), _c("Color", (0.5, 0.5, 1.0)), _p("space", SPACE_TANGENT),

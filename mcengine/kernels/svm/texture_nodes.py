@@ -5,14 +5,15 @@ order of ``nodes.VALUE_NODES``, outputs to regs[c:].  The Vector input is
 always present: when nothing is linked to it, the compiler links the
 texture coordinate Cycles uses by default (Generated, or UV for images).
 Each texture's entry point is called, not inlined (compile time); Perlin
-noise and its fractals are in ``noise.py``, Voronoi in ``voronoi.py``,
-Cycles' hashes in ``hash.py``.
+noise and its fractals are in ``noise.py``, Voronoi in ``voronoi.py``, Gabor in
+``gabor.py``, Cycles' hashes in ``hash.py``.
 """
 from __future__ import annotations
 
 import math
 
 from ...jit import device, function
+from .gabor import gabor_node
 from .hash import hash_float, hash_float2, hash_float3, hash_float4, r32
 from .math_nodes import fmod
 from .nodes import NODES, OFFSETS, OUTPUT_OFFSETS
@@ -56,6 +57,8 @@ _VO_W_OUT, _VO_RADIUS = _VOO["W"], _VOO["Radius"]
 _GRADIENT = NODES["TexGradient"].code
 _GR_VECTOR = OFFSETS["TexGradient"]["Vector"]
 _GR_TYPE = OFFSETS["TexGradient"]["prop:gradient_type"]
+
+_GABOR = NODES["TexGabor"].code
 
 _WAVE = NODES["TexWave"].code
 _WV = OFFSETS["TexWave"]
@@ -102,6 +105,8 @@ def eval_texture_node(code, regs, b, c, sd, tex):
         brick_node(regs, b, c)
     elif code == _MAGIC:
         magic_node(regs, b, c)
+    elif code == _GABOR:
+        gabor_node(regs, b, c)
 
 
 @device

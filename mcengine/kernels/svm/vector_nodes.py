@@ -1,5 +1,6 @@
 """Vector nodes: Mapping (kernel/svm/mapping.h, mapping_util.h), Vector Rotate
-(kernel/svm/vector_rotate.h) and Vector Transform (kernel/svm/vector_transform.h).
+(kernel/svm/vector_rotate.h), Vector Transform (kernel/svm/vector_transform.h) and
+Normal (kernel/svm/normal.h).
 
 ``eval_vector_node`` evaluates one node of the family: inputs at regs[b:] in
 the order of ``nodes.VALUE_NODES``, outputs to regs[c:].
@@ -43,6 +44,8 @@ _VECTOR_TRANSFORM = NODES["VectorTransform"].code
 _VT_TYPE = OFFSETS["VectorTransform"]["prop:vector_type"]
 _VT_FROM = OFFSETS["VectorTransform"]["prop:convert_from"]
 _VT_TO = OFFSETS["VectorTransform"]["prop:convert_to"]
+_NORMAL_NODE = NODES["Normal"].code
+_NN_DIRECTION = OFFSETS["Normal"]["prop:direction"]
 _WORLD = TRANSFORM_SPACES["WORLD"]
 _OBJECT = TRANSFORM_SPACES["OBJECT"]
 _CAMERA = TRANSFORM_SPACES["CAMERA"]
@@ -64,6 +67,19 @@ def eval_vector_node(code, regs, b, c, sd, tex):
         vector_rotate(regs, b, c)
     elif code == _VECTOR_TRANSFORM:
         vector_transform(regs, b, c, sd, tex)
+    elif code == _NORMAL_NODE:
+        normal_node(regs, b, c)
+
+
+@device
+def normal_node(regs, b, c):
+    """Normal: the node's unit direction, and its dot product with the unit Normal input
+    (svm_node_normal; a zero vector normalises to zero here, to NaN in Cycles)."""
+    dx, dy, dz = safe_normalize(regs[b + _NN_DIRECTION], regs[b + _NN_DIRECTION + 1],
+                                regs[b + _NN_DIRECTION + 2])
+    nx, ny, nz = safe_normalize(regs[b], regs[b + 1], regs[b + 2])
+    regs[c], regs[c + 1], regs[c + 2] = dx, dy, dz
+    regs[c + 3] = dx * nx + dy * ny + dz * nz
 
 
 @device

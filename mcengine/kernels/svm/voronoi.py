@@ -13,14 +13,13 @@ import math
 
 from ...jit import device, function
 from .hash import hash_float, hash_float2, pcg2, pcg3, pcg4
+from .math_nodes import FLT_MAX
 from .nodes import CHEBYCHEV, EUCLIDEAN, MANHATTAN, MINKOWSKI
 from .nodes import VORONOI_DISTANCE_TO_EDGE as DISTANCE_TO_EDGE
 from .nodes import VORONOI_F1 as F1
 from .nodes import VORONOI_F2 as F2
 from .nodes import VORONOI_N_SPHERE_RADIUS as N_SPHERE_RADIUS
 from .nodes import VORONOI_SMOOTH_F1 as SMOOTH_F1
-
-FLT_MAX = 3.4028234663852886e38
 
 
 @device

@@ -578,6 +578,7 @@ def _isotropic(node) -> bool:
 # property naming it); the attribute's offset goes to their "prop:attribute" input.
 _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map"),
                       "VertexColor": ("", "layer_name"), "NormalMap": (TANGENT_PREFIX, "uv_map"),
+                      "VectorDisplacement": (TANGENT_PREFIX, "uv_map"),
                       "Tangent": (TANGENT_PREFIX, "uv_map")}
 
 

@@ -65,10 +65,12 @@ class MaterialTable:
         return names
 
     def tangent_maps(self, indices) -> set:
-        """UV maps whose tangents the materials at ``indices`` read (Normal Map nodes in
-        tangent space, Tangent nodes along a UV map; "" is the default UV map)."""
+        """UV maps whose tangents the materials at ``indices`` read (Normal Map and Vector
+        Displacement nodes in tangent space, the latter the default UV map's; Tangent nodes
+        along a UV map; "" is the default UV map)."""
         return {str(node.props.get("uv_map", "")) for i in set(indices) for node in self.materials[i].nodes
-                if node.type == "NormalMap" and str(node.props.get("space", "TANGENT")) == "TANGENT"
+                if node.type in ("NormalMap", "VectorDisplacement")
+                and str(node.props.get("space", "TANGENT")) == "TANGENT"
                 or node.type == "Tangent" and str(node.props.get("direction_type")) == "UV_MAP"}
 
     def index(self, material) -> int:

@@ -7,7 +7,8 @@ displaced surface is), its Normal (the normals recomputed after displacement: sm
 the normalised sum of their vertices' face normals, flat faces their own), the Texture
 Coordinate's Generated output (the point before displacement, Cycles' generated attribute)
 or a texture on the UV map.  Heights from Noise on Generated and UV coordinates, a vector
-fed straight to the output, Object and World space, a turned and stretched object,
+fed straight to the output, Object and World space, a turned and stretched object, the
+Vector Displacement node in tangent, object and world space (also as bump),
 'Displacement and Bump' (moved, and bumped), and Bump nodes on a displaced surface: their
 heights are evaluated at the undisplaced point and normal with the undisplaced triangle's
 ray differential, as Cycles' bump evaluation does there.
@@ -61,6 +62,18 @@ def _noise(nt, coord="Generated", scale=3.0):
     return tex.outputs["Fac"]
 
 
+def _noise_vector(nt, coord):
+    """Three noises' Fac (scales 3, 5 and 2) as a vector.  Not the Noise's Color: its green
+    and blue are noise at the point plus an offset of 100-200, rounded to float32 in both
+    engines (1.5e-5 apart there), and a bump's finite differences over a few hundredths
+    turn the roundings where the engines' points differ by a float32 ulp into normals
+    7e-4 apart (measured at 5-8 % of the pixels)."""
+    combine = nt.nodes.new("ShaderNodeCombineXYZ")
+    for k, scale in enumerate((3.0, 5.0, 2.0)):
+        nt.links.new(_noise(nt, coord, scale), combine.inputs[k])
+    return combine.outputs["Vector"]
+
+
 def _show(nt, what):
     if what in ("Position", "Normal"):
         return nt.nodes.new("ShaderNodeNewGeometry").outputs[what]
@@ -73,13 +86,22 @@ def _show(nt, what):
 
 
 def _displaced(show="Position", method="DISPLACEMENT", coord="Generated", scale=0.3,
-               space="OBJECT", vector=False, bump=None):
+               space="OBJECT", vector=False, bump=None, vector_node=False):
     """A displaced plane showing ``show``; with ``bump`` (a texture coordinate), the Normal
-    output of a Bump node (Distance 0.1) of a noise on that coordinate."""
+    output of a Bump node (Distance 0.1) of a noise on that coordinate; with
+    ``vector_node`` a Vector Displacement node of three noises (midlevel 0.5) in
+    ``space``."""
     def build(nt):
         _material(nt).displacement_method = method
         out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-        if vector:
+        if vector_node:
+            disp = nt.nodes.new("ShaderNodeVectorDisplacement")
+            disp.space = space
+            disp.inputs["Midlevel"].default_value = 0.5
+            disp.inputs["Scale"].default_value = scale
+            nt.links.new(_noise_vector(nt, coord), disp.inputs["Vector"])
+            nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+        elif vector:
             # A vector straight to the output: moved sideways by noise.
             combine = nt.nodes.new("ShaderNodeCombineXYZ")
             nt.links.new(_noise(nt, coord), combine.inputs["X"])
@@ -120,6 +142,14 @@ CASES = {
                                                _prepare(smooth=True, turned=True)),
     "bump node on object": (_displaced(bump="Object"), _prepare(smooth=True)),
     "bump node on uv, flat": (_displaced(bump="UV"), _prepare()),
+    # Vector Displacement: tangent space along the UV map's tangents, object and world space
+    **{f"vector displacement {space.lower()}{' turned' if turned else ''}": (
+        _displaced(space=space, vector_node=True), _prepare(smooth=True, turned=turned))
+       for space in ("TANGENT", "OBJECT", "WORLD") for turned in (False, True)},
+    "vector displacement tangent normal": (_displaced("Normal", space="TANGENT", vector_node=True),
+                                           _prepare(smooth=True, turned=True)),
+    "vector displacement tangent as bump": (_displaced("Normal", method="BUMP", space="TANGENT",
+                                                      vector_node=True), _prepare(smooth=True)),
 }
 
 

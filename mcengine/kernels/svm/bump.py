@@ -33,7 +33,7 @@ from ...jit import device, function
 from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
 from .input_nodes import attribute, normal_to_object, normal_to_world, transform_direction, transform_point
 from .math_nodes import safe_normalize
-from .nodes import OFFSETS, SPACE_OBJECT
+from .nodes import OFFSETS, SPACE_OBJECT, SPACE_TANGENT, SPACE_WORLD
 
 _BUMP_STRENGTH = OFFSETS["Bump"]["Strength"]
 _BUMP_DISTANCE = OFFSETS["Bump"]["Distance"]
@@ -50,6 +50,10 @@ _DISP_MIDLEVEL = OFFSETS["Displacement"]["Midlevel"]
 _DISP_SCALE = OFFSETS["Displacement"]["Scale"]
 _DISP_NORMAL = OFFSETS["Displacement"]["Normal"]
 _DISP_SPACE = OFFSETS["Displacement"]["prop:space"]
+_VD_MIDLEVEL = OFFSETS["VectorDisplacement"]["Midlevel"]
+_VD_SCALE = OFFSETS["VectorDisplacement"]["Scale"]
+_VD_SPACE = OFFSETS["VectorDisplacement"]["prop:space"]
+_VD_TANGENT = OFFSETS["VectorDisplacement"]["prop:attribute"]
 
 
 @device
@@ -253,3 +257,28 @@ def displacement(regs, b, sd, tex):
         nx, ny, nz = normal_to_object(row, nx, ny, nz)
         return transform_direction(row, OBJ_MATRIX, nx * f, ny * f, nz * f)
     return nx * f, ny * f, nz * f
+
+
+@device
+def vector_displacement(regs, b, sd, tex):
+    """Cycles' svm_node_vector_displacement: (Vector - Midlevel) x Scale, in world space.
+
+    Tangent space: x along the default UV map's tangent, y along the shading normal (taken
+    to object space), z along the bitangent normalize(N x T) times the tangent's sign;
+    tangent and object space are then brought to world space by the object's matrix (a
+    direction).  Without a tangent (no UV map, or no triangle) a tangent-space vector is
+    left in object space."""
+    m, s = regs[b + _VD_MIDLEVEL], regs[b + _VD_SCALE]
+    x, y, z = (regs[b] - m) * s, (regs[b + 1] - m) * s, (regs[b + 2] - m) * s
+    space = int(regs[b + _VD_SPACE])
+    if space == SPACE_WORLD or sd.obj < 0:
+        return x, y, z
+    row = tex.objects[sd.obj]
+    off = int(regs[b + _VD_TANGENT])
+    if space == SPACE_TANGENT and off >= 0 and sd.prim >= 0:
+        nx, ny, nz = normal_to_object(row, sd.nx, sd.ny, sd.nz)
+        tx, ty, tz, sign = attribute(tex, sd, off, 4)
+        bx, by, bz = safe_normalize(ny * tz - nz * ty, nz * tx - nx * tz, nx * ty - ny * tx)
+        bx, by, bz = sign * bx, sign * by, sign * bz
+        x, y, z = (tx * x + nx * y + bx * z, ty * x + ny * y + by * z, tz * x + nz * y + bz * z)
+    return transform_direction(row, OBJ_MATRIX, x, y, z)

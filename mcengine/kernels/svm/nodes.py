@@ -355,7 +355,7 @@ FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural textures (401-449);
                        # svm/image_nodes.py: image textures (450-469)
 IMAGE_CODES = 450      # first code of the image nodes
 FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Rotate, Vector Transform, Normal
-FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump
+FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump, Displacement, Vector Displacement
 
 # Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
 # of the single-output coordinate nodes the compiler inserts for implicit inputs).
@@ -542,6 +542,11 @@ VALUE_NODES = {
                      (_v("Normal", UNLINKED),), False),
     "Displacement": NodeSpec(603, (_f("Height", 0.0), _f("Midlevel", 0.5), _f("Scale", 0.01), _v("Normal"),
                                    _p("space", SPACE_OBJECT)), (_v("Displacement", UNLINKED),), False),
+    # Vector Displacement: "prop:attribute" is the default UV map's tangent attribute (tangent
+    # space; TANGENT_PREFIX)
+    "VectorDisplacement": NodeSpec(604, (_c("Vector", (0.8, 0.8, 0.8)), _f("Midlevel", 0.0), _f("Scale", 0.01),
+                                         _p("space", SPACE_TANGENT), _p("attribute", -1)),
+                                   (_v("Displacement", UNLINKED),), False),
 }
 # The Bump node's three heights: at the point, at the point moved along dPdx and along dPdy.
 BUMP_HEIGHTS = ("Height", "Height_dx", "Height_dy")

@@ -1,5 +1,5 @@
 """Normal nodes: a perturbed shading normal for the closures (kernel/svm/tex_coord.h);
-Bump is in ``bump.py``.
+Bump, Displacement and Vector Displacement are in ``bump.py``.
 
 Normal Map works as Cycles does, in object space: the MikkTSpace tangent and
 sign of the UV map (per-corner attribute ``tangent:<uv map>``, object space, as
@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
-from .bump import bump_normal, displacement
+from .bump import bump_normal, displacement, vector_displacement
 from .input_nodes import attribute, normal_to_object, normal_to_world
 from .math_nodes import safe_normalize
 from .nodes import (
@@ -33,6 +33,7 @@ _NM_SPACE = OFFSETS["NormalMap"]["prop:space"]
 _NM_TANGENT = OFFSETS["NormalMap"]["prop:attribute"]
 _BUMP = NODES["Bump"].code
 _DISPLACEMENT = NODES["Displacement"].code
+_VECTOR_DISPLACEMENT = NODES["VectorDisplacement"].code
 
 
 @function
@@ -45,6 +46,9 @@ def eval_normal_node(code, regs, b, c, sd, tex):
         regs[c], regs[c + 1], regs[c + 2] = x, y, z
     elif code == _DISPLACEMENT:
         x, y, z = displacement(regs, b, sd, tex)
+        regs[c], regs[c + 1], regs[c + 2] = x, y, z
+    elif code == _VECTOR_DISPLACEMENT:
+        x, y, z = vector_displacement(regs, b, sd, tex)
         regs[c], regs[c + 1], regs[c + 2] = x, y, z
 
 

@@ -175,6 +175,16 @@ class FrameFinding:
                "in the noise"
 
 
+def _frame_difference(report: dict, ch: str) -> str:
+    """How channel ``ch``'s frame mean differs: relative to Cycles', or both means where
+    Cycles' is zero (a channel it renders black, where a relative difference is undefined)."""
+    rel = report["frame"]["rel_bias"][ch]
+    if rel is not None:
+        return f"{ch} {100 * rel:+.1f}%"
+    ours, ref = report["means"]["mcengine"][ch]["mean"], report["means"]["cycles"][ch]["mean"]
+    return f"{ch} {ours:.4g} against Cycles' {ref:.4g}"
+
+
 def frame_finding(report: dict) -> FrameFinding:
     """The frame test's result as a person should read it.
 
@@ -189,7 +199,7 @@ def frame_finding(report: dict) -> FrameFinding:
     differs = [ch for ch, d in frame["differs"].items() if d]
     if differs:
         return FrameFinding("differ", "frame mean differs", ", ".join(
-            f"{ch} {100 * frame['rel_bias'][ch]:+.1f}%" for ch in differs), math.nan)
+            _frame_difference(report, ch) for ch in differs), math.nan)
     values = ", ".join(f"{ch} {100 * v:+.2f}%" for ch, v in frame["rel_bias"].items()
                        if v is not None)
     detectable = [math.inf if v is None else v for ch, v in frame["detectable_bias"].items()

@@ -59,14 +59,14 @@ def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
 
 def test_unsupported_texture_into_base_color_gives_exactly_one_warning(scene, fake_session):
     mat = principled("Wood", Base_Color=(0.5, 0.25, 0.1, 1))
-    wire = mat.node_tree.nodes.new("ShaderNodeWireframe")
-    mat.node_tree.links.new(wire.outputs["Fac"],
+    bevel = mat.node_tree.nodes.new("ShaderNodeBevel")
+    mat.node_tree.links.new(bevel.outputs["Normal"],
                             mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
     m, warnings = exported(fake_session, mat)
     assert surface(m).inputs["Base Color"] == pytest.approx((0.5, 0.25, 0.1))
-    assert warnings == ["material 'Wood': Wireframe into Principled BSDF 'Base Color' not "
+    assert warnings == ["material 'Wood': Bevel into Principled BSDF 'Base Color' not "
                         "supported yet; unlinked value of Principled BSDF 'Base Color' used"]
-    assert "Wireframe node" in scene.mcengine.last_ignored
+    assert "Bevel node" in scene.mcengine.last_ignored
 
 
 @pytest.mark.parametrize("change", ["translation", "scale", "use_min", "mapping_x", "mapping"])

@@ -58,6 +58,22 @@ def test_a_brighter_rectangle_is_one_region_with_its_pixels(rng):
         assert rel == pytest.approx(0.2, abs=0.03)
 
 
+def test_a_channel_cycles_renders_black_is_reported_by_its_means(rng, tmp_path):
+    """Where Cycles' frame is black in a channel (a blue surface under white light), a
+    relative difference is undefined: a differing channel is reported by both means (it
+    once crashed the comparison with a TypeError)."""
+    cycles = _image()
+    cycles[..., 0] = 0.0
+    ours = _image()
+    c = build_comparison("black red", _runs(ours, rng), _runs(cycles, rng))
+    assert c.verdict == "differ" and c.report["frame"]["rel_bias"]["R"] is None
+    finding = frame_finding(c.report)
+    mean_r = c.report["means"]["mcengine"]["R"]["mean"]
+    assert finding.kind == "differ" and finding.values == f"R {mean_r:.4g} against Cycles' 0"
+    write_comparison(c, tmp_path)
+    assert "R (n/a)" in (tmp_path / "report.md").read_text()
+
+
 def test_two_separate_patches_are_two_regions(rng):
     ours = _image()
     ours[0:6, 0:8, 0] *= 1.4        # block (0, 0), red only, brighter

@@ -59,6 +59,7 @@ SCENES = (
     "material_subsurface",
     "ray_visibility",
     "light_linking",
+    "material_nodes_extra",
 )
 
 

@@ -312,3 +312,30 @@ def test_ignored_light_linking_is_caught(renders):
     result = renders.compare("light_linking", "every light lights everything", _unlinked)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _falloff_left_out(scene):
+    """The panel's Light Falloff removed (what MC Engine rendered before it evaluated the
+    node: the Emission's unlinked Strength)."""
+    tree = scene.objects["Panel"].active_material.node_tree
+    emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    for link in list(emission.inputs["Strength"].links):
+        tree.links.remove(link)
+
+
+def _wireframe_left_out(scene):
+    tree = scene.objects["Wire"].active_material.node_tree
+    mix = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeMixShader")
+    for link in list(mix.inputs["Fac"].links):
+        tree.links.remove(link)
+
+
+@pytest.mark.parametrize("what,edit", [("Light Falloff left out", _falloff_left_out),
+                                       ("Wireframe left out", _wireframe_left_out)])
+def test_left_out_nodes_are_caught(renders, what, edit):
+    """material_nodes_extra without its Light Falloff (the panel at its unlinked Strength
+    1 instead of 4 t / (1 + 0.5 / t^2)) or its Wireframe (the sphere half and half): blocks
+    differ."""
+    result = renders.compare("material_nodes_extra", what, edit)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

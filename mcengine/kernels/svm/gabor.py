@@ -12,9 +12,10 @@ coordinates and the impulse's number (``hash``), so the pattern is Cycles' own.
 from __future__ import annotations
 
 import math
+import struct
 
 from ...jit import device, function
-from .hash import hash_float3, hash_float4
+from .hash import float_bits, hash_uint3, hash_uint4, unit
 from .nodes import OFFSETS, OUTPUT_OFFSETS
 
 IMPULSES_COUNT = 8
@@ -27,6 +28,11 @@ _GB_ORIENTATION_2D, _GB_ORIENTATION_3D = _GB["Orientation 2D"], _GB["Orientation
 _GB_TYPE = _GB["prop:gabor_type"]
 _GBO = OUTPUT_OFFSETS["TexGabor"]
 _GB_VALUE, _GB_PHASE, _GB_INTENSITY = _GBO["Value"], _GBO["Phase"], _GBO["Intensity"]
+
+# The float32 bit patterns of each impulse's seeds 3i, 3i + 1, 3i + 2 (the last key of its
+# orientation, centre and sign hashes).
+_SEED_BITS = tuple(tuple(struct.unpack("<I", struct.pack("<f", float(3 * i + j)))[0] for j in range(3))
+                   for i in range(IMPULSES_COUNT))
 
 # sqrt(impulses x second moment 1/2 x the integral of the squared kernel: 1/4 in 2D,
 # 1/(4 sqrt 2) in 3D)
@@ -43,18 +49,34 @@ def _kernel(distance_squared, phase):
 
 
 @device
+def _h3(a, b, c):
+    """hash_float3_to_float of keys given as their float32 bit patterns."""
+    return unit(hash_uint3(a, b, c))
+
+
+@device
+def _h4(a, b, c, d):
+    """hash_float4_to_float of keys given as their float32 bit patterns."""
+    return unit(hash_uint4(a, b, c, d))
+
+
+@device
 def _cell_2d(cx, cy, px, py, frequency, isotropy, base_orientation):
+    # The cell's keys as bit patterns once, not once per hash (float_bits is not free); the
+    # kernel centre first, so that the impulses out of reach (most) skip the rest: the
+    # same values as Cycles, which draws the orientation first.
+    bx, by = float_bits(cx), float_bits(cy)
     re = im = 0.0
     for i in range(IMPULSES_COUNT):
-        k = float(i * 3)
-        orientation = base_orientation + (hash_float3(cx, cy, k) - 0.5) * math.pi * isotropy
-        # hash_float3_to_float2 of the kernel centre's seed
-        qx = px - hash_float3(cx, cy, k + 1.0)
-        qy = py - hash_float3(k + 1.0, cx, cy)
+        k, k1, k2 = _SEED_BITS[i]
+        # hash_float3_to_float2 of the kernel centre's seed (cx, cy, 3i + 1)
+        qx = px - _h3(bx, by, k1)
+        qy = py - _h3(k1, bx, by)
         d2 = qx * qx + qy * qy
         if d2 >= 1.0:
             continue
-        weight = -1.0 if hash_float3(cx, cy, k + 2.0) < 0.5 else 1.0
+        orientation = base_orientation + (_h3(bx, by, k) - 0.5) * math.pi * isotropy
+        weight = -1.0 if _h3(bx, by, k2) < 0.5 else 1.0
         fx, fy = frequency * math.cos(orientation), frequency * math.sin(orientation)
         a, b = _kernel(d2, 2.0 * math.pi * (qx * fx + qy * fy))
         re += weight * a
@@ -76,35 +98,35 @@ def gabor_2d(x, y, frequency, isotropy, orientation):
 
 
 @device
-def _orientation_3d(ox, oy, oz, isotropy, sx, sy, sz, sw):
-    """The base orientation turned by random inclination and azimuth angles (in [0, pi]) times
-    the isotropy (compute_3d_orientation)."""
-    if isotropy == 0.0:
-        return ox, oy, oz
+def _base_angles(ox, oy, oz):
+    """Inclination and azimuth of the unit base orientation (compute_3d_orientation)."""
     inclination = math.acos(oz)
     azimuth = (-1.0 if oy < 0.0 else 1.0) * math.acos(ox / math.sqrt(ox * ox + oy * oy))
-    # hash_float4_to_float2
-    inclination += hash_float4(sx, sy, sz, sw) * math.pi * isotropy
-    azimuth += hash_float4(sz, sx, sw, sy) * math.pi * isotropy
-    s = math.sin(inclination)
-    return s * math.cos(azimuth), s * math.sin(azimuth), math.cos(inclination)
+    return inclination, azimuth
 
 
 @device
-def _cell_3d(cx, cy, cz, px, py, pz, frequency, isotropy, ox, oy, oz):
+def _cell_3d(cx, cy, cz, px, py, pz, frequency, isotropy, ox, oy, oz, inclination, azimuth):
+    bx, by, bz = float_bits(cx), float_bits(cy), float_bits(cz)
     re = im = 0.0
     for i in range(IMPULSES_COUNT):
-        k = float(i * 3)
-        dx, dy, dz = _orientation_3d(ox, oy, oz, isotropy, cx, cy, cz, k)
-        # hash_float4_to_float3 of the kernel centre's seed (cx, cy, cz, k + 1)
-        w = k + 1.0
-        qx = px - hash_float4(cx, cy, cz, w)
-        qy = py - hash_float4(cz, cx, w, cy)
-        qz = pz - hash_float4(w, cz, cy, cx)
+        k, w, k2 = _SEED_BITS[i]
+        # hash_float4_to_float3 of the kernel centre's seed (cx, cy, cz, 3i + 1)
+        qx = px - _h4(bx, by, bz, w)
+        qy = py - _h4(bz, bx, w, by)
+        qz = pz - _h4(w, bz, by, bx)
         d2 = qx * qx + qy * qy + qz * qz
         if d2 >= 1.0:
             continue
-        weight = -1.0 if hash_float4(cx, cy, cz, k + 2.0) < 0.5 else 1.0
+        dx, dy, dz = ox, oy, oz
+        if isotropy != 0.0:
+            # the base turned by random angles in [0, pi] times the isotropy
+            # (hash_float4_to_float2 of the seed (cx, cy, cz, 3i))
+            t = inclination + _h4(bx, by, bz, k) * math.pi * isotropy
+            f = azimuth + _h4(bz, bx, k, by) * math.pi * isotropy
+            s = math.sin(t)
+            dx, dy, dz = s * math.cos(f), s * math.sin(f), math.cos(t)
+        weight = -1.0 if _h4(bx, by, bz, k2) < 0.5 else 1.0
         a, b = _kernel(d2, 2.0 * math.pi * frequency * (qx * dx + qy * dy + qz * dz))
         re += weight * a
         im += weight * b
@@ -115,12 +137,13 @@ def _cell_3d(cx, cy, cz, px, py, pz, frequency, isotropy, ox, oy, oz):
 def gabor_3d(x, y, z, frequency, isotropy, ox, oy, oz):
     fx, fy, fz = math.floor(x), math.floor(y), math.floor(z)
     lx, ly, lz = x - fx, y - fy, z - fz
+    inclination, azimuth = _base_angles(ox, oy, oz)
     re = im = 0.0
     for k in range(-1, 2):
         for j in range(-1, 2):
             for i in range(-1, 2):
                 a, b = _cell_3d(fx + i, fy + j, fz + k, lx - i, ly - j, lz - k, frequency,
-                                isotropy, ox, oy, oz)
+                                isotropy, ox, oy, oz, inclination, azimuth)
                 re += a
                 im += b
     return re, im

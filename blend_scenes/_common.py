@@ -108,14 +108,17 @@ def apply_render_settings(scene):
     set_bounces(scene, total=4, diffuse=4)
 
 
-def set_bounces(scene, total, diffuse, glossy=4, transmission=12):
+def set_bounces(scene, total, diffuse, glossy=4, transmission=12, caustics=True):
     """Set the bounce limits explicitly.
 
     Cycles stops a path at whichever limit is reached first, the total or the
     per-type one, so every limit is written rather than left to the defaults
-    (whose glossy 4 / transmission 12 are the default arguments here).
+    (whose glossy 4 / transmission 12 are the default arguments here).  With
+    ``caustics`` False, Caustics Reflective and Refractive are turned off (a
+    mirror's caustics of a small light would be fireflies that drown a comparison).
     """
     cycles = scene.cycles
+    cycles.caustics_reflective = cycles.caustics_refractive = caustics
     cycles.max_bounces = total
     cycles.diffuse_bounces = diffuse
     cycles.glossy_bounces = glossy

@@ -49,9 +49,7 @@ def _receivers(name, *links):
 
 def build(scene):
     c.set_world(scene, (0.05, 0.05, 0.06))
-    c.set_bounces(scene, 6, 4, glossy=6, transmission=6)
-    scene.cycles.caustics_reflective = False
-    scene.cycles.caustics_refractive = False
+    c.set_bounces(scene, 6, 4, glossy=6, transmission=6, caustics=False)
     floor = c.add_floor(scene)
     diffuse = c.diffuse_material
     red = c.add_uv_sphere(scene, "Red", 0.4, diffuse("Red", (0.8, 0.15, 0.1)),

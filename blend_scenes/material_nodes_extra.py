@@ -110,9 +110,7 @@ def _dented_material():
 
 def build(scene):
     c.set_world(scene, (0.04, 0.045, 0.05))
-    c.set_bounces(scene, 6, 4, glossy=6, transmission=6)
-    scene.cycles.caustics_reflective = False
-    scene.cycles.caustics_refractive = False
+    c.set_bounces(scene, 6, 4, glossy=6, transmission=6, caustics=False)
     c.add_floor(scene)
     c.add_quad(scene, "Panel", [(-0.7, 0.25, 2.2), (-0.7, -0.25, 2.2), (0.7, -0.25, 2.2),
                                 (0.7, 0.25, 2.2)], _panel_material())

@@ -49,9 +49,7 @@ def _hide(obj, *rays):
 
 def build(scene):
     c.set_world(scene, (0.08, 0.09, 0.1))
-    c.set_bounces(scene, 6, 4, glossy=6, transmission=6)
-    scene.cycles.caustics_reflective = False
-    scene.cycles.caustics_refractive = False
+    c.set_bounces(scene, 6, 4, glossy=6, transmission=6, caustics=False)
     c.add_floor(scene)
     diffuse = c.diffuse_material
     ghost = c.add_uv_sphere(scene, "Ghost", 0.45, diffuse("Ghost", (0.8, 0.15, 0.1)),

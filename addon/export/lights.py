@@ -5,8 +5,9 @@ strength = color x energy x 2**exposure, times ``temperature_color`` when
 uses as ``Light.temperature_color``), times the emission of the lamp's node tree when
 that is constant (the default is white x 1): an Emission shader, also with value nodes
 (Blackbody, RGB, Math, ...) and Mix or Add Shaders on constant inputs, compiled and folded
-as a material's graph is (``mcengine.shaders``).  A tree that varies over the lamp (Light
-Falloff, IES Texture, textures on its coordinates) is warned and left out.
+as a material's graph is (``mcengine.shaders``; a Light Falloff's Quadratic without Smooth
+is its Strength).  A tree that varies over the lamp (Light Falloff's other outputs or with
+Smooth, IES Texture, textures on its coordinates) is warned and left out.
 
 Shadow casting is ``light.use_shadow``; MIS and max bounces come from
 ``light.cycles``; the camera/diffuse/glossy/transmission visibility from the

@@ -60,6 +60,7 @@ SCENES = (
     "ray_visibility",
     "light_linking",
     "material_nodes_extra",
+    "material_bevel_ao",
 )
 
 

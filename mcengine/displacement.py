@@ -33,6 +33,7 @@ import numpy as np
 from .images import ImageTable
 from .kernels.camera import pack_camera
 from .kernels.displace import displacement_offsets
+from .kernels.subsurface import no_local_bvh
 from .kernels.svm import TextureData
 from .packing import areas_and_normals, pack_attributes, pack_objects
 from .scene import Geometry, SceneDescription
@@ -159,7 +160,7 @@ def _evaluate(scene: SceneDescription, g: Geometry, corner_tri, corner, normals)
                       images=images.info, pix8=images.pix8, pixf=images.pixf)
     out = np.zeros((len(corner_tri), 3))
     displacement_offsets(np.array(ops, np.int32).reshape(-1, 4), np.array(ranges, np.int32).reshape(-1, 2),
-                         np.array(results, np.int64), registers, tex, verts, tris, ng,
+                         np.array(results, np.int64), registers, tex, verts, tris, no_local_bvh(), ng,
                          np.ascontiguousarray(g.material_index, np.int32),
                          corner_tri.astype(np.int32), corner.astype(np.int32), normals, out)
     return out

@@ -35,8 +35,10 @@ plan names them (``camera``).
 Besides the effects, the plan lists what the scene holds: light types, the
 kinds of surface (read from the materials' shader graphs) and the materials
 whose shaders evaluate nodes at every hit (textures, inputs) rather than only
-build closures from constants.  ``summary()`` is the line shown in the MC
-Engine panel, on the command line and in the comparison and study reports.
+build closures from constants, and those whose nodes trace rays of their own (Bevel and
+Ambient Occlusion: their objects, and for AO the scene, get hierarchies to trace).
+``summary()`` is the line shown in the MC Engine panel, on the command line and in the
+comparison and study reports.
 
 Every effect can be forced on (``RenderSession(..., force_effects=...)``):
 the benchmark (``benchmarks/bench_effects_plan.py``) measures what the plan
@@ -64,8 +66,12 @@ from .kernels.state import (
     MF_TRANSPARENT,
 )
 from .kernels.svm import OP_NODE
+from .kernels.svm.nodes import NODES
 from .scene import Link
 from .shaders import UNDISPLACED_ATTRIBUTE
+
+# Shader nodes that trace rays of their own (kernels/svm/bevel.py, ao.py).
+TRACING_NODES = ("Bevel", "AmbientOcclusion")
 
 # Effect name -> (label for people, cfg flag that switches it in the kernels).
 EFFECTS = {
@@ -91,6 +97,8 @@ class EffectsPlan:
     world_sampled: bool = False    # the world is a light for next-event estimation (its map)
     camera: tuple = ()             # "depth of field", "motion blur (...)": what the camera sees
     displaced: int = 0             # meshes moved by true displacement (``displacement``)
+    traced: int = 0                # materials with nodes that trace rays (TRACING_NODES: their
+                                   # objects, and for AO the scene, get hierarchies to trace)
     # The effects (see the module docstring); each is a kernel flag.
     nee: bool = False
     lamps_hit: bool = False
@@ -136,6 +144,9 @@ class EffectsPlan:
             textures += f", {self.images} image{'s' if self.images > 1 else ''}"
         if self.displaced:
             textures += f"; {self.displaced} displaced mesh{'es' if self.displaced > 1 else ''}"
+        if self.traced:
+            textures += (f"; {self.traced} material{'s' if self.traced > 1 else ''} with "
+                         f"ray-traced nodes")
         camera = f"; {', '.join(self.camera)}" if self.camera else ""
         return (f"Lights: {', '.join(lights) if lights else 'none'}; "
                 f"surfaces: {', '.join(self.lobes) if self.lobes else 'black'}; {textures}{camera} | "
@@ -191,15 +202,18 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         kinds |= surface_kinds(scene.materials[i])
     lamps_hit = lamps_hit_by_rays(lamps)
     nee = bool(lamps) or emissive_triangles > 0 or world_sampled
-    textures = 0
+    textures = traced = 0
     if programs is not None:
         ops, ranges = programs
         textures = sum(1 for i in used if np.any(ops[ranges[i][0]:ranges[i][1], 0] == OP_NODE))
+        traced = len(set(used) & {i for name in TRACING_NODES
+                                  for i in materials_with_node(programs, name)})
     return EffectsPlan(
         lobes=tuple(k for k in LOBE_ORDER if k in kinds),
         textures=textures,
         camera=camera_effects(scene),
         displaced=displaced_meshes(scene.geometry),
+        traced=traced,
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
         emissive_triangles=int(emissive_triangles),
@@ -214,6 +228,14 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         subsurface="subsurface" in kinds,
         light_linking=nee and light_linked(lamps, scene.geometry),
     )
+
+
+def materials_with_node(programs, name: str) -> list:
+    """The materials whose shader programs (``(ops, ranges)``) evaluate a ``name`` node."""
+    ops, ranges = programs
+    code = NODES[name].code
+    return [i for i, (start, end) in enumerate(ranges)
+            if np.any((ops[start:end, 0] == OP_NODE) & (ops[start:end, 1] == code))]
 
 
 def light_linked(lamps, geometry) -> bool:

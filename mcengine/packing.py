@@ -17,7 +17,7 @@ import numpy as np
 
 from . import cryptomatte, integrators, samplers
 from .background import map_size, world_map
-from .features import EffectsPlan, lamps_intersectable, surface_kinds
+from .features import TRACING_NODES, EffectsPlan, lamps_intersectable, materials_with_node, surface_kinds
 from .features import detect as detect_plan
 from .images import ImageTable
 from .kernels.camera import pack_camera
@@ -76,6 +76,7 @@ from .kernels.state import (
     VIS_DIFFUSE,
     VIS_GLOSSY,
     VIS_SCATTER,
+    VIS_SHADOW,
     VIS_TRANSMISSION,
     SceneData,
     alloc_scratch,
@@ -242,13 +243,24 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     if force_effects:
         plan = plan.force(force_effects)
 
-    if plan.subsurface and len(tris):
-        # The objects a subsurface walk may run in: those with a subsurface material.
-        walked = [i for i, mat in enumerate(scene.materials) if "subsurface" in surface_kinds(mat)]
+    if (plan.subsurface or plan.traced) and len(tris):
+        # The objects a subsurface walk may run in (those with a subsurface material when
+        # walks are on) and those a Bevel or Ambient Occlusion node traces get hierarchies of
+        # their own; AO nodes' rays also meet the rest of the scene: every triangle shadow
+        # rays see, in one more.
+        programs = (shaders.ops, shaders.ranges)
+        walked = [i for name in TRACING_NODES for i in materials_with_node(programs, name)]
+        if plan.subsurface:
+            walked += [i for i, mat in enumerate(scene.materials) if "subsurface" in surface_kinds(mat)]
+        scene_ids = None
+        if materials_with_node(programs, "AmbientOcclusion"):
+            visibility = scene.geometry.triangle_visibility()
+            scene_ids = np.arange(len(tris), dtype=np.int32) if visibility is None else \
+                np.flatnonzero(visibility & VIS_SHADOW).astype(np.int32)
         tri_object = sc.tex.tri_object
         sc = sc._replace(local=build_local_bvh(
             verts, tris, tri_object, sc.tex.objects.shape[0],
-            np.unique(tri_object[np.isin(mat_index, walked)])))
+            np.unique(tri_object[np.isin(mat_index, walked)]), scene_ids=scene_ids))
 
     x0, y0, x1, y1 = film.window
     sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,

@@ -333,6 +333,10 @@ class RenderSession:
             self.warnings.append(f"{self.integrator.name} does not render holdouts (Holdout "
                                  f"shaders and holdout objects): they render as ordinary "
                                  f"surfaces; Path Tracing renders them as Cycles")
+        if self._classic and self.plan.traced:
+            self.warnings.append(f"{self.integrator.name} does not trace Bevel and Ambient "
+                                 f"Occlusion nodes: they give the shading normal and no "
+                                 f"occlusion; Path Tracing traces them as Cycles")
         if self._classic and self.plan.light_linking:
             self.warnings.append(f"{self.integrator.name} does not honour light linking: every "
                                  f"light lights every object; Path Tracing honours it as Cycles")

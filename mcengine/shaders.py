@@ -56,6 +56,7 @@ from .kernels.state import (
     MF_EMISSIVE,
     MF_TRANSPARENT,
 )
+from .kernels.subsurface import no_local_bvh
 from .kernels.svm import (
     BUMP_CENTER,
     BUMP_DX,
@@ -585,13 +586,15 @@ _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map
 # What the compiler shows a node it evaluates ahead of time: no point, no scene (and, public,
 # what a program run on the host without a scene reads: tests/core/test_closure_rows.py).
 _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
-                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0.0)
+                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0.0,
+                          np.uint64(0), 0.0)
 NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
                           tri_object=np.zeros(0, np.int32),
                           objects=np.zeros((0, OBJ_STRIDE)), camera=np.zeros(CAMERA_PARAMS),
                           images=np.zeros((0, IMG_STRIDE), np.int64), pix8=np.zeros(0, np.uint8),
                           pixf=np.zeros(0, np.float32))
-NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32))     # verts, tris (SceneData's types)
+# verts, tris and the objects' own hierarchies (SceneData's types)
+NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32), no_local_bvh())
 
 
 class ShaderTable:

@@ -375,6 +375,7 @@ def run_compare(request: CompareRequest) -> int:
     log = BlenderLog(passthrough=request.verbose)
     with log.capture():
         bpy = _start_blender(register=True)
+    from mcengine.evaluation.comparison import fmt_num
     from mcengine.evaluation.output import write_comparison
 
     from ..batch.comparison import CompareError, CompareOptions, compare_file, run_suite
@@ -389,7 +390,8 @@ def run_compare(request: CompareRequest) -> int:
 
         def on_done(row):
             detail = row.error if row.verdict == "error" else (
-                f"relMSE {row.relmse:.3g}, FLIP {row.flip:.3f}, blocks differ {row.blocks_differ}")
+                f"relMSE {fmt_num(row.relmse, '.3g')}, FLIP {fmt_num(row.flip, '.3f')}, "
+                f"blocks differ {row.blocks_differ}")
             console.write(f"{PROG}: {row.scene}: {row.verdict} ({detail})\n")
 
         with log.capture():

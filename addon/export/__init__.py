@@ -158,7 +158,7 @@ def export(depsgraph, camera=None, parts=PARTS, previous: ExportResult | None = 
     desc.images = _images_used(desc, {**(old.images if old is not None else {}), **ctx.images})
     if shutter is not None and layout is not None:
         desc.motion_blur = _export_motion(ctx, depsgraph, frame_set, shutter, layout, cam)
-        motion.warn_moving_wireframes(ctx, desc)
+        motion.warn_moving_frame_geometry(ctx, desc)
     desc.passes.motion_blur = shutter is not None
     if vectors is not None and layout is not None and "Vector" in desc.passes.enabled:
         desc.motion_vectors = _export_motion_vectors(ctx, depsgraph, frame_set, vectors, layout,

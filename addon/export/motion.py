@@ -212,21 +212,33 @@ def moves(om: ObjectMotion) -> bool:
     return om.positions is not None or not all(np.array_equal(m, om.matrices[0]) for m in om.matrices)
 
 
-def warn_moving_wireframes(ctx, desc) -> None:
-    """Warn when moving objects use a material with a Wireframe node: its edges are their
-    triangles' at the frame's time (the evaluator reads the frame's vertices), where Cycles
-    takes them at each ray's time."""
-    wired = {k for k, m in enumerate(desc.materials) if any(n.type == "Wireframe" for n in m.nodes)}
-    if not wired or desc.motion_blur is None:
+# Nodes that read an object's triangles themselves: what they see of them.
+_FRAME_GEOMETRY_NODES = {"Wireframe": "the edges of their triangles",
+                         "Bevel": "their surfaces' normals around the point"}
+
+
+def warn_moving_frame_geometry(ctx, desc) -> None:
+    """Warn when moving objects use a material with a Wireframe or Bevel node: it reads their
+    triangles as they are at the frame's time (the evaluator reads the frame's vertices, the
+    Bevel node their hierarchy), where Cycles takes them at each ray's time."""
+    if desc.motion_blur is None:
         return
     g = desc.geometry
-    names = [g.object_names[om.object] for om in desc.motion_blur.objects if moves(om)
-             and wired & set(np.unique(g.material_index[g.object_index == om.object]).tolist())]
-    if names:
-        from .mesh import listed
-        ctx.warn(f"Wireframe on moving objects ({listed(names)}): the edges of their triangles as "
-                 f"they are at the frame, not as they move during the shutter",
-                 "Wireframe under motion blur")
+    for kind, what in _FRAME_GEOMETRY_NODES.items():
+        used = {k for k, m in enumerate(desc.materials) if any(n.type == kind for n in m.nodes)}
+        names = [g.object_names[om.object] for om in desc.motion_blur.objects if moves(om)
+                 and used & set(np.unique(g.material_index[g.object_index == om.object]).tolist())]
+        if names:
+            from .mesh import listed
+            ctx.warn(f"{kind} on moving objects ({listed(names)}): {what} as they are at the "
+                     f"frame, not as they move during the shutter", f"{kind} under motion blur")
+    if any(n.type == "AmbientOcclusion" for m in desc.materials for n in m.nodes):
+        names = [g.object_names[om.object] for om in desc.motion_blur.objects if moves(om)]
+        if names:
+            from .mesh import listed
+            ctx.warn(f"Ambient Occlusion with moving objects ({listed(names)}): they occlude "
+                     f"as they are at the frame, not as they move during the shutter",
+                     "Ambient Occlusion under motion blur")
 
 
 def key_name(key) -> str:

@@ -106,6 +106,16 @@ def _output_value_props(name, size):
     return props
 
 
+def _ao_props(node, ctx) -> dict:
+    """Ambient Occlusion: a Distance of 0 that nothing is linked to is the world's AO distance
+    (World > Light Settings > Distance; Cycles' NODE_AO_GLOBAL_RADIUS), else -1 (its own)."""
+    distance = node.inputs["Distance"]
+    world = ctx.scene.world
+    if distance.is_linked or distance.default_value != 0.0:
+        return {"global_distance": -1.0}
+    return {"global_distance": float(world.light_settings.distance) if world is not None else 0.0}
+
+
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
 # ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
 SPECIAL_PROPS = {
@@ -119,6 +129,7 @@ SPECIAL_PROPS = {
     "RGBCurve": _curve_props(3, True),
     "VectorCurve": _curve_props(3, False),
     "FloatCurve": _curve_props(1, False),
+    "AmbientOcclusion": _ao_props,
 }
 
 

@@ -118,8 +118,8 @@ class Comparison:
         finding = frame_finding(self.report)
         caveat = f"; {finding.caveat}" if finding.caveat else ""
         return (f"{self.scene}: {self.verdict} (frame MC/Cycles-1 {bias}{caveat}; "
-                f"{blocks['differ']}/{blocks['tested']} blocks differ; relMSE {m['relmse']:.4g}, "
-                f"FLIP {m['flip']:.3f})")
+                f"{blocks['differ']}/{blocks['tested']} blocks differ; relMSE {fmt_num(m['relmse'])}, "
+                f"FLIP {fmt_num(m['flip'], '.3f')})")
 
 
 def detectable_bias(agreement: Agreement, power: float = DETECTION_POWER) -> np.ndarray:
@@ -288,13 +288,25 @@ def _finite(v):
     return v if math.isfinite(v) else None
 
 
-def _flip(ours_rgb: np.ndarray, cycles_rgb: np.ndarray) -> float:
-    """Mean HDR-FLIP of ours against Cycles (flip-evaluator, linear RGB input)."""
+_FLIP_MIN_VALUE = 1e-20     # a reference with no larger value is black to HDR-FLIP
+
+
+def _flip(ours_rgb: np.ndarray, cycles_rgb: np.ndarray) -> float | None:
+    """Mean HDR-FLIP of ours against Cycles (flip-evaluator, linear RGB input); None where
+    Cycles' image is black: HDR-FLIP's exposures come from the reference's largest luminance,
+    and without one flip-evaluator ends the whole process (Blender with it)."""
     import flip_evaluator
     ref = np.ascontiguousarray(np.maximum(cycles_rgb, 0.0), np.float32)
     test = np.ascontiguousarray(np.maximum(ours_rgb, 0.0), np.float32)
+    if not np.max(ref, initial=0.0) > _FLIP_MIN_VALUE:
+        return None
     _, mean, _ = flip_evaluator.evaluate(ref, test, "HDR", applyMagma=False)
     return float(mean)
+
+
+def fmt_num(v, fmt=".4g") -> str:
+    """A metric for people: "n/a" where there is none (None)."""
+    return "n/a" if v is None else format(v, fmt)
 
 
 def build_comparison(scene: str, ours: EngineRuns, cycles: EngineRuns, *, grid=(8, 8),

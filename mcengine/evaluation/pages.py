@@ -15,7 +15,7 @@ import html
 import math
 
 from ..integrators import INTEGRATORS
-from .comparison import DETECTION_POWER, POWER_BIAS, Comparison, SuiteRow, frame_finding
+from .comparison import DETECTION_POWER, POWER_BIAS, Comparison, SuiteRow, fmt_num, frame_finding
 from .stats import CHANNELS
 from .study import (
     CONFIDENCE,
@@ -66,10 +66,6 @@ def _scaled(v, factor=100.0):
     return None if v is None else factor * v
 
 
-def _num(v, fmt=".4g") -> str:
-    return "n/a" if v is None else format(v, fmt)
-
-
 def report_markdown(c: Comparison) -> str:
     """``report.md``: the report for people."""
     r = c.report
@@ -109,11 +105,11 @@ def report_markdown(c: Comparison) -> str:
         mo, mc = r["means"]["mcengine"][ch], r["means"]["cycles"][ch]
         lo, hi = r["frame"]["rel_bias_ci"][ch]
         lines.append(
-            f"| {ch} | {_num(mo['mean'], '.5f')} [{_num(mo['ci'][0], '.5f')}, {_num(mo['ci'][1], '.5f')}] "
-            f"| {_num(mc['mean'], '.5f')} [{_num(mc['ci'][0], '.5f')}, {_num(mc['ci'][1], '.5f')}] "
+            f"| {ch} | {fmt_num(mo['mean'], '.5f')} [{fmt_num(mo['ci'][0], '.5f')}, {fmt_num(mo['ci'][1], '.5f')}] "
+            f"| {fmt_num(mc['mean'], '.5f')} [{fmt_num(mc['ci'][0], '.5f')}, {fmt_num(mc['ci'][1], '.5f')}] "
             f"| {_pct(r['frame']['rel_bias'][ch])} [{_pct(lo)}, {_pct(hi)}] "
-            f"| {_num(r['frame']['t'][ch], '+.2f')} | {_num(r['frame']['p_holm'][ch], '.3g')} "
-            f"| {_num(_scaled(r['frame']['detectable_bias'][ch]), '.2g')} % |")
+            f"| {fmt_num(r['frame']['t'][ch], '+.2f')} | {fmt_num(r['frame']['p_holm'][ch], '.3g')} "
+            f"| {fmt_num(_scaled(r['frame']['detectable_bias'][ch]), '.2g')} % |")
     m, b = r["metrics"], r["blocks"]
     gy, gx = r["test"]["grid"]
     lines += ["", "## Image metrics", "",
@@ -121,7 +117,7 @@ def report_markdown(c: Comparison) -> str:
               "| metric | value |", "| --- | --- |",
               f"| relMSE (top 0.1 % of pixels trimmed) | {m['relmse']:.5g} |",
               f"| SMAPE | {m['smape']:.5g} |",
-              f"| mean HDR-FLIP | {m['flip']:.5g} |",
+              f"| mean HDR-FLIP | {fmt_num(m['flip'], '.5g')} |",
               f"| significant blocks ({gx} x {gy} grid) | {b['differ']} / {b['tested']} "
               f"({100 * b['share_differ']:.1f} %) |",
               "| pixel correlation (block, frame scale) | MC Engine "
@@ -182,8 +178,8 @@ def _cells(row: SuiteRow) -> list:
     return [row.scene, _verdict_cell(row),
             f"{100 * row.max_abs_bias:.2f} %" if row.max_abs_bias is not None else "",
             f"{100 * row.detectable_bias:.2g} %" if row.detectable_bias is not None else "",
-            row.blocks_differ, _num(row.relmse, ".3g"), _num(row.flip, ".3f"),
-            _num(row.seconds_ours, ".2f"), _num(row.seconds_cycles, ".2f"), _ratio(row)]
+            row.blocks_differ, fmt_num(row.relmse, ".3g"), fmt_num(row.flip, ".3f"),
+            fmt_num(row.seconds_ours, ".2f"), fmt_num(row.seconds_cycles, ".2f"), _ratio(row)]
 
 
 def _low_power(row: SuiteRow) -> bool:

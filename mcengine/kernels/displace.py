@@ -20,13 +20,14 @@ from .svm import ShadingData, eval_values
 
 
 @kernel
-def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, ng, mat_index,
+def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, local, ng, mat_index,
                          corner_tri, corner, normals, out):
     """The displacement (world space) at corner ``corner[j]`` of triangle ``corner_tri[j]``,
     whose unit vertex normal is ``normals[j]``, into ``out[j]``: the rows
     [ranges[m, 0], ranges[m, 1]) of ``ops`` of the triangle's material m run at the vertex
     and leave the vector in registers ``results[m]`` to ``results[m] + 2`` of ``regs``.
-    ``ng`` are the triangles' unit geometric normals.  A component that is not finite
+    ``ng`` are the triangles' unit geometric normals; ``local`` is a ``subsurface.LocalBVH``
+    the shader evaluator takes (Bevel nodes trace nothing here, as in Cycles).  A component that is not finite
     becomes 0 (Cycles' ``ensure_finite``)."""
     i64, f64 = np.int64, np.float64
     for j in range(corner_tri.shape[0]):
@@ -35,13 +36,14 @@ def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, ng, mat_i
         m = mat_index[t]
         vert = tris[t, k]
         nx, ny, nz = f64(normals[j, 0]), f64(normals[j, 1]), f64(normals[j, 2])
+        u = f64(1.0 if k == 1 else 0.0)     # (not inside the call: numba takes no branches
+        v = f64(1.0 if k == 2 else 0.0)     # among that many arguments)
         sd = ShadingData(f64(verts[vert, 0]), f64(verts[vert, 1]), f64(verts[vert, 2]), nx, ny, nz,
                          f64(ng[t, 0]), f64(ng[t, 1]), f64(ng[t, 2]), nx, ny, nz,
-                         False, False, True, True, False, i64(t),
-                         f64(1.0 if k == 1 else 0.0), f64(1.0 if k == 2 else 0.0),
+                         False, False, True, True, False, i64(t), u, v,
                          i64(tex.tri_object[t]), i64(0), 0.0,
-                         i64(0), i64(0), i64(0), i64(0), i64(0), 0.0)
-        eval_values(ops, ranges[m, 0], ranges[m, 1], regs, sd, tex, verts, tris)
+                         i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
+        eval_values(ops, ranges[m, 0], ranges[m, 1], regs, sd, tex, verts, tris, local)
         r = results[m]
         for c in range(3):
             x = regs[r + c]

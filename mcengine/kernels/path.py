@@ -100,6 +100,7 @@ from .sampling import (
     SET_TERMINATE,
     bounce_set,
     exit_key,
+    node_key,
     sample_1d,
     sample_2d,
     sample_4d,
@@ -290,7 +291,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             rtr = rtg = rtb = 0.0
         else:
             res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
-                              not terminate, depths, footprint, walks)
+                              not terminate, depths, footprint, walks, node_key(st.key[i], vertex),
+                              st.min_pdf[i])
             ncl, rtr, rtg, rtb = res.n, res.tr, res.tg, res.tb
 
             # Holdout: the film's alpha drops by the holdout weight on camera paths. A holdout

@@ -63,6 +63,7 @@ _K_SEED_B = np.uint64(0x5851F42D4C957F2D)   # any odd 64-bit constants
 _K_SEED_C = np.uint64(0x14057B7EF767814F)
 _K_WALK = np.uint64(0x2545F4914F6CDD1D)
 _K_WALK_SETS = np.uint64(0x9FB21C651E98DF25)
+_K_NODES = np.uint64(0xD6E8FEB86659FD93)
 
 
 @device
@@ -106,6 +107,23 @@ def exit_key(key, vertex):
     bits) stays, so the Sobol sampler stays stratified over the pixel's samples."""
     h = mix64((key >> np.uint64(SAMPLE_BITS)) ^ (np.uint64(vertex + 1) * _K_WALK))
     return key ^ (h << np.uint64(SAMPLE_BITS))
+
+
+@device
+def node_key(key, vertex):
+    """Key of the numbers that ray-traced shader nodes (Bevel) draw at path vertex ``vertex``:
+    a hash of the path's key (its sample index included), so every sample has its own."""
+    return mix64(key ^ (np.uint64(vertex + 1) * _K_NODES))
+
+
+@device
+def branched_2d(key, branch):
+    """Point ``branch`` of a set of 2D points drawn at one shading point (a node's samples),
+    the set stratified as Cycles' path_branched_rng_2D stratifies it: the first points of an
+    Owen-scrambled Sobol (0, 2)-sequence, scrambled by seeds hashed from ``key``."""
+    h = mix64(key ^ _K_SEED_B)
+    j = reversed_index(branch) << np.uint64(32 - INDEX_BITS)
+    return sobol_2d(j, h & _M32, h >> np.uint64(32))
 
 
 @device
@@ -264,6 +282,23 @@ def orthonormal_basis(nx, ny, nz):
     tx, ty, tz = 1.0 + sign * nx * nx * a, sign * b, -sign * nx
     bx, by, bz = b, sign + ny * ny * a, -ny
     return tx, ty, tz, bx, by, bz
+
+
+@device
+def make_orthonormals(nx, ny, nz):
+    """Cycles' make_orthonormals: a = normalize((1, 1, 1) x n) (or (-1, 1, 1) x n when the
+    components are equal), b = n x a.  Where Cycles builds a frame this way and the result
+    depends on how the frame turns about n (the Bump node's tangents, the three-axis disk
+    probes of subsurface scattering and Bevel), this frame is used, not ``orthonormal_basis``."""
+    if nx != ny or nx != nz:
+        ax, ay, az = nz - ny, nx - nz, ny - nx
+    else:
+        ax, ay, az = nz - ny, nx + nz, -ny - nx
+    n = math.sqrt(ax * ax + ay * ay + az * az)
+    if n != 0.0:
+        inv = 1.0 / n
+        ax, ay, az = ax * inv, ay * inv, az * inv
+    return ax, ay, az, ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
 
 
 @device

@@ -322,7 +322,7 @@ def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, 
 
 @device
 def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b1, b2, obj, flags,
-                 ray_length, depths, dp):
+                 ray_length, depths, dp, rng=0, min_pdf=0.0):
     """The ``ShadingData`` of surface point ``sp`` for a ray of direction d, every field of
     one fixed type (float64, bool, int64; numba's int() and float() would keep an int32 an
     int32 and a float32 a float32), whatever its callers pass: the shader evaluator and
@@ -334,12 +334,13 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
                        -f64(dx), -f64(dy), -f64(dz), bool(sp.backfacing), bool(allocate),
                        bool(reflective), bool(refractive), bool(bump), i64(prim), f64(b1), f64(b2),
                        i64(obj), i64(flags), f64(ray_length), i64(depths[0]), i64(depths[1]),
-                       i64(depths[2]), i64(depths[3]), i64(depths[4]), f64(dp))
+                       i64(depths[2]), i64(depths[3]), i64(depths[4]), f64(dp), np.uint64(rng),
+                       f64(min_pdf))
 
 
 @device
 def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths,
-                footprint, walks=False):
+                footprint, walks=False, rng=0, min_pdf=0.0):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
     direction d and length t_hit (from the vertex it left, through transparent surfaces, as
     Cycles measures it), on a path with ``flags`` and ``depths`` (bounces: all, diffuse,
@@ -351,6 +352,9 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
     ``allocate`` false only emission, transparency and holdout are computed.  BSSRDF
     closures stay for a caller that ``walks`` (the path tracer with subsurface walks on);
     for others they become Lambert closures of their weight (Cycles' zero-radius limit).
+    A path's own shading gives ``rng``, the key of the numbers of ray-traced nodes, and
+    ``min_pdf``, its smallest BSDF pdf so far; 0 (shadow rays, exits of walks): those nodes
+    trace nothing.
     """
     from_diffuse = (flags & PF_DIFFUSE) != 0
     obj = sc.tex.tri_object[p]
@@ -358,13 +362,13 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
                       cfg[CFG_CAUSTICS_REFLECTIVE] != 0 or not from_diffuse,
                       cfg[CFG_CAUSTICS_REFRACTIVE] != 0 or not from_diffuse,
                       (sc.mat_flags[m] & MF_BUMP_CORRECTION) != 0,
-                      p, b1, b2, obj, flags, t_hit, depths, footprint)
+                      p, b1, b2, obj, flags, t_hit, depths, footprint, rng, min_pdf)
     if sc.mat_flags[m] & MF_CLOSURES_ONLY:
         res = eval_closure_rows(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                                 scratch.cl, sd)
     else:
         res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                          scratch.cl, sd, sc.tex, sc.verts, sc.tris)
+                          scratch.cl, sd, sc.tex, sc.verts, sc.tris, sc.local)
     if not walks:
         for k in range(res.n):
             if scratch.cl[k, CL_TYPE] == CT_BSSRDF:
@@ -390,7 +394,7 @@ def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths, time):
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
                       sc.tex.tri_object[tri], PF_EMISSION, dist, depths, 0.0)
     res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris)
+                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris, sc.local)
     return res.er, res.eg, res.eb
 
 

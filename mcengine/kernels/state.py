@@ -110,7 +110,9 @@ SceneData = namedtuple("SceneData", [
     "bg_conditional",  # (H, W + 1) f64  CDF over the columns of each row (kernels.background)
     "bg_sun",        # (5,) f64     a sun cone sampled beside the map: direction, cos of its
                      #              half angle, the share of world samples it gets (0: none)
-    "local",         # kernels.subsurface.LocalBVH: each subsurface object's own triangles
+    "local",         # kernels.subsurface.LocalBVH: the own triangles of each object that a
+                     #              subsurface walk, a Bevel or an AO node traces, and the
+                     #              scene's that AO nodes trace (slot O)
 ])
 
 # Material flags (mat_flags).

@@ -41,7 +41,7 @@ from . import embree
 from .closures.bssrdf import disk_sample, disk_weight
 from .embree import intersect_one
 from .motion import BVH_LEAF, build_bvh, hit_triangle, ray_box
-from .sampling import orthonormal_basis, rand, sample_2d, sample_4d
+from .sampling import make_orthonormals, orthonormal_basis, rand, sample_2d, sample_4d
 
 MAX_STEPS = 256                  # Cycles' BSSRDF_MAX_BOUNCES
 SIMILARITY_LEVEL = 9             # steps with the real phase function (Cycles' similarity level)
@@ -63,21 +63,28 @@ LocalBVH = namedtuple("LocalBVH", [
 
 
 def no_local_bvh(objects: int = 0) -> LocalBVH:
-    """A LocalBVH without hierarchies (no subsurface material in the scene)."""
+    """A LocalBVH without hierarchies (nothing that a subsurface walk, a Bevel or an Ambient
+    Occlusion node traces)."""
     return LocalBVH(np.zeros((objects, 2), np.int32), np.zeros((0, 6)), np.zeros((0, 3), np.int32),
                     np.zeros(0, np.int32), np.zeros(objects, np.int64), np.zeros(objects, np.int64),
                     np.zeros(1, np.int64))
 
 
-def build_local_bvh(verts, tris, tri_object, objects, wanted, embree_scenes=True) -> LocalBVH:
+def build_local_bvh(verts, tris, tri_object, objects, wanted, embree_scenes=True,
+                    scene_ids=None) -> LocalBVH:
     """One hierarchy over each object in ``wanted`` (object indices), over its own triangles
     as they are at the frame: an Embree scene each (as Cycles' walk uses Embree), or, with
     ``embree_scenes=False`` or where the library is not found, compiled hierarchies here.
+    With ``scene_ids`` (triangle ids), one more hierarchy over those, as slot ``objects``:
+    the scene that Ambient Occlusion nodes' rays meet.
 
     The Embree scenes are released when the returned ``embree`` array is garbage collected.
     """
     objects_ids = [(o, np.flatnonzero(tri_object == o).astype(np.int32))
                    for o in sorted(set(int(w) for w in wanted))]
+    if scene_ids is not None:
+        objects_ids.append((objects, np.asarray(scene_ids, np.int32)))
+        objects += 1
     objects_ids = [(o, ids) for o, ids in objects_ids if len(ids)]
     if not objects_ids:
         return no_local_bvh(objects)
@@ -421,17 +428,56 @@ def _hit_weight(normals, tri_normal, p, hx, hy, hz, px, py, pz, flip, axes, pick
 
 @device
 def hit_normal(normals, tri_normal, p, flip):
-    """Triangle p's geometric normal, on the side its corner normals say (a mirrored
-    object's winding is reversed), flipped when the probe started on a back face."""
-    gx, gy, gz = tri_normal[p, 0], tri_normal[p, 1], tri_normal[p, 2]
+    """Triangle p's geometric normal, on the side its corner normals say, flipped when the
+    probe started on a back face."""
+    gx, gy, gz = facing_corners(normals, p, tri_normal[p, 0], tri_normal[p, 1], tri_normal[p, 2])
+    if flip:
+        gx, gy, gz = -gx, -gy, -gz
+    return gx, gy, gz
+
+
+@device
+def facing_corners(normals, p, gx, gy, gz):
+    """The normal g of triangle p, on the side its corner normals say (the object's outside:
+    a mirrored object's winding is reversed)."""
     sx = normals[p, 0, 0] + normals[p, 1, 0] + normals[p, 2, 0]
     sy = normals[p, 0, 1] + normals[p, 1, 1] + normals[p, 2, 1]
     sz = normals[p, 0, 2] + normals[p, 1, 2] + normals[p, 2, 2]
     if sx * gx + sy * gy + sz * gz < 0.0:
-        gx, gy, gz = -gx, -gy, -gz
-    if flip:
-        gx, gy, gz = -gx, -gy, -gz
+        return -gx, -gy, -gz
     return gx, gy, gz
+
+
+@device
+def probe(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, key):
+    """Every surface of object ``obj`` on the probe o + t d, 0 < t < tmax, nearest first: the
+    first four, then (reservoir sampling with hashes of ``key``) a uniform subset of four, as
+    Cycles' local intersection keeps them.  Returns (count of surfaces crossed, the four
+    kept triangles (-1: none), their distances)."""
+    count = 0
+    p0 = p1 = p2 = p3 = -1
+    t0 = t1 = t2 = t3 = 0.0
+    t = 0.0
+    p = -1
+    while count < MAX_STEPS:
+        step, p = local_closest(lb, verts, tris, obj, ox + t * dx, oy + t * dy, oz + t * dz,
+                                dx, dy, dz, tmax - t, p)
+        if p < 0:
+            break
+        t += step
+        count += 1
+        slot = count - 1
+        if count > DISK_MAX_HITS:
+            slot = int(rand(key, 16 + count) * count)
+        if slot == 0:
+            p0, t0 = p, t
+        elif slot == 1:
+            p1, t1 = p, t
+        elif slot == 2:
+            p2, t2 = p, t
+        elif slot == 3:
+            p3, t3 = p, t
+    return count, p0, p1, p2, p3, t0, t1, t2, t3
 
 
 @device
@@ -445,7 +491,9 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, p
     key's dimension set 0; the reservoir's choices beyond four surfaces are hashes.
     """
     u1, u2, u_resample, _ = sample_4d(sampler, wkey, 0, mask)
-    tx, ty, tz, bx, by, bz = orthonormal_basis(ngx, ngy, ngz)
+    # Cycles' frame: the MIS over the three axes leaves out the other axes' disk densities,
+    # so what a probe finds depends on how the frame turns about the normal.
+    tx, ty, tz, bx, by, bz = make_orthonormals(ngx, ngy, ngz)
     nx, ny, nz = ngx, ngy, ngz
     if u2 < 0.5:
         pick_n, pick_t, pick_b = 0.5, 0.25, 0.25
@@ -464,32 +512,8 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, p
     oy = py + ny * h + ty * c + by * s
     oz = pz + nz * h + tz * c + bz * s
     dx, dy, dz = -nx, -ny, -nz
-    # Every surface of the object on the probe (0, 2h), nearest first: the first four, then
-    # reservoir sampling keeps a uniform subset of four.
-    count = 0
-    p0 = p1 = p2 = p3 = -1
-    t0 = t1 = t2 = t3 = 0.0
-    tmax = 2.0 * h
-    t = 0.0
-    p = -1
-    while count < MAX_STEPS:
-        step, p = local_closest(lb, verts, tris, obj, ox + t * dx, oy + t * dy, oz + t * dz,
-                                dx, dy, dz, tmax - t, p)
-        if p < 0:
-            break
-        t += step
-        count += 1
-        slot = count - 1
-        if count > DISK_MAX_HITS:
-            slot = int(rand(wkey, 16 + count) * count)
-        if slot == 0:
-            p0, t0 = p, t
-        elif slot == 1:
-            p1, t1 = p, t
-        elif slot == 2:
-            p2, t2 = p, t
-        elif slot == 3:
-            p3, t3 = p, t
+    count, p0, p1, p2, p3, t0, t1, t2, t3 = probe(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz,
+                                                  2.0 * h, wkey)
     if count == 0:
         return False, -1, px, py, pz, ngx, ngy, ngz, 0.0, 0.0, 0.0
     scale = count / DISK_MAX_HITS if count > DISK_MAX_HITS else 1.0

@@ -25,9 +25,9 @@ def _plane_under_sun(scene, unsupported=False):
     bsdf = tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.6, 0.6, 0.6, 1.0)
     bsdf.inputs["Specular IOR Level"].default_value = 0.0
-    if unsupported:  # MC Engine ignores the Bevel node: its plane stays grey (Cycles': blue)
-        bevel = tree.nodes.new("ShaderNodeBevel")
-        tree.links.new(bevel.outputs["Normal"], bsdf.inputs["Base Color"])
+    if unsupported:  # MC Engine ignores the Curves Info node: its plane stays grey (Cycles':
+        info = tree.nodes.new("ShaderNodeHairInfo")       # black, a mesh is not a strand)
+        tree.links.new(info.outputs["Is Strand"], bsdf.inputs["Base Color"])
     mesh.materials.append(material)
     scene.collection.objects.link(bpy.data.objects.new("Plane", mesh))
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
@@ -92,7 +92,7 @@ def test_a_difference_is_a_warning_naming_what_mc_engine_ignored(scene, tmp_path
     assert _compare(tmp_path) == {"FINISHED"}
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["verdict"] == "differ"
-    assert any("Bevel" in note for note in report["notes"])
+    assert any("HairInfo" in note for note in report["notes"])
     out, err = capfd.readouterr()
     assert "Warning: Compare with Cycles: Scene: differ" in out + err
 

@@ -59,14 +59,14 @@ def test_principled_inputs_and_distribution_are_copied(scene, fake_session):
 
 def test_unsupported_texture_into_base_color_gives_exactly_one_warning(scene, fake_session):
     mat = principled("Wood", Base_Color=(0.5, 0.25, 0.1, 1))
-    bevel = mat.node_tree.nodes.new("ShaderNodeBevel")
-    mat.node_tree.links.new(bevel.outputs["Normal"],
+    info = mat.node_tree.nodes.new("ShaderNodeHairInfo")
+    mat.node_tree.links.new(info.outputs["Is Strand"],
                             mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
     m, warnings = exported(fake_session, mat)
     assert surface(m).inputs["Base Color"] == pytest.approx((0.5, 0.25, 0.1))
-    assert warnings == ["material 'Wood': Bevel into Principled BSDF 'Base Color' not "
+    assert warnings == ["material 'Wood': Curves Info into Principled BSDF 'Base Color' not "
                         "supported yet; unlinked value of Principled BSDF 'Base Color' used"]
-    assert "Bevel node" in scene.mcengine.last_ignored
+    assert "HairInfo node" in scene.mcengine.last_ignored
 
 
 @pytest.mark.parametrize("change", ["translation", "scale", "use_min", "mapping_x", "mapping"])
@@ -105,6 +105,27 @@ def test_linked_texture_is_copied_with_its_properties(scene, fake_session):
     assert tex.type == "TexChecker" and tex.inputs["Scale"] == 7.0
     vector = tex.inputs["Vector"]
     assert isinstance(vector, Link) and vector.socket == "UV" and m.nodes[vector.node].type == "TexCoord"
+    assert warnings == []
+
+
+@pytest.mark.parametrize("distance,expected", [(0.0, 3.5), (0.25, -1.0)])
+def test_ambient_occlusion_reads_the_worlds_distance_for_a_distance_of_0(scene, fake_session,
+                                                                         distance, expected):
+    """Cycles' AO node takes the world's AO distance (World > Light Settings) where its own
+    Distance is 0 and unlinked: the export writes it (or -1) as ``global_distance``."""
+    scene.world = bpy.data.worlds.new("World")
+    scene.world.light_settings.distance = 3.5
+    mat = principled("Dirt")
+    tree = mat.node_tree
+    ao = tree.nodes.new("ShaderNodeAmbientOcclusion")
+    ao.inputs["Distance"].default_value = distance
+    ao.samples, ao.only_local = 5, True
+    tree.links.new(ao.outputs["AO"], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    m, warnings = exported(fake_session, mat)
+    node = m.nodes[surface(m).inputs["Roughness"].node]
+    assert node.type == "AmbientOcclusion" and node.inputs["Distance"] == distance
+    assert (node.props["global_distance"], node.props["samples"], node.props["only_local"]) == \
+        (expected, 5.0, 1.0)
     assert warnings == []
 
 

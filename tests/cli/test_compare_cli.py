@@ -24,7 +24,7 @@ MCENGINE = Path(sys.executable).with_name("mcengine")
 CORNELL_BOX = REPO / "blend_scenes" / "cornell_box.blend"
 TIMEOUT = 300  # seconds; a tiny comparison takes seconds, JIT compilation more
 
-# A plane under a sun, once plain and once with a Bevel node's normal as its colour
+# A plane under a sun, once plain and once with a Curves Info node's Is Strand as its colour
 # (which MC Engine does not support, so that comparison must say "differ"), and a
 # scene without a camera (the renders fail).
 MAKE_SCENES = textwrap.dedent("""
@@ -47,8 +47,8 @@ MAKE_SCENES = textwrap.dedent("""
     scene.collection.objects.link(bpy.data.objects.new("Plane", mesh))
     scene.collection.objects.link(bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN")))
     bpy.ops.wm.save_as_mainfile(filepath=out + "/plain.blend")
-    bevel = mat.node_tree.nodes.new("ShaderNodeBevel")
-    mat.node_tree.links.new(bevel.outputs["Normal"], bsdf.inputs["Base Color"])
+    info = mat.node_tree.nodes.new("ShaderNodeHairInfo")
+    mat.node_tree.links.new(info.outputs["Is Strand"], bsdf.inputs["Base Color"])
     bpy.ops.wm.save_as_mainfile(filepath=out + "/textured.blend")
     scene.camera = None
     bpy.data.objects.remove(cam)
@@ -168,7 +168,7 @@ def test_compare_exits_3_on_differ_and_says_why(scenes, tmp_path):
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["verdict"] == "differ"
     assert report["regions"], "the dark plane should show as regions"
-    assert "Bevel" in (tmp_path / "report.md").read_text()
+    assert "HairInfo" in (tmp_path / "report.md").read_text()
     assert "warning:" in done.stderr and "textured: differ" in done.stderr
 
 

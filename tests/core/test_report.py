@@ -74,6 +74,18 @@ def test_a_channel_cycles_renders_black_is_reported_by_its_means(rng, tmp_path):
     assert "R (n/a)" in (tmp_path / "report.md").read_text()
 
 
+def test_a_black_cycles_image_is_compared_without_flip(rng, tmp_path):
+    """Cycles' image entirely black (a scene only MC Engine lights): HDR-FLIP has no exposure
+    range there, and flip-evaluator then ends the process (Blender with it: the Compare with
+    Cycles operator once closed Blender so); the comparison reports FLIP as n/a."""
+    cycles = np.zeros_like(_image())
+    c = build_comparison("black", _runs(_image(), rng), _runs(cycles, rng))
+    assert c.verdict == "differ" and c.report["metrics"]["flip"] is None
+    assert "FLIP n/a" in c.summary()
+    write_comparison(c, tmp_path)
+    assert "| mean HDR-FLIP | n/a |" in (tmp_path / "report.md").read_text()
+
+
 def test_two_separate_patches_are_two_regions(rng):
     ours = _image()
     ours[0:6, 0:8, 0] *= 1.4        # block (0, 0), red only, brighter

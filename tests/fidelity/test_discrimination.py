@@ -339,3 +339,35 @@ def test_left_out_nodes_are_caught(renders, what, edit):
     result = renders.compare("material_nodes_extra", what, edit)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _bevel_left_out(scene):
+    """The Block's Bevel unlinked from its Principled Normal (what MC Engine rendered before
+    it evaluated the node: sharp edges)."""
+    tree = scene.objects["Block"].active_material.node_tree
+    bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    for link in list(bsdf.inputs["Normal"].links):
+        tree.links.remove(link)
+
+
+def test_left_out_bevel_is_caught(renders):
+    """material_bevel_ao with sharp edges on the Block (its highlights along the rounded edges
+    gone): blocks differ."""
+    result = renders.compare("material_bevel_ao", "Bevel left out of the Block", _bevel_left_out)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
+def _ao_own_object_only(scene):
+    """The floor's Ambient Occlusion meeting only the floor (Only Local: no occlusion at
+    all, what a node that traced nothing would give)."""
+    tree = scene.objects["Floor"].active_material.node_tree
+    next(n for n in tree.nodes if n.bl_idname == "ShaderNodeAmbientOcclusion").only_local = True
+
+
+def test_ao_that_ignores_the_scene_is_caught(renders):
+    """material_bevel_ao without the boxes' occlusion of the floor: the floor around them
+    lighter; blocks differ."""
+    result = renders.compare("material_bevel_ao", "AO of the floor alone", _ao_own_object_only)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

@@ -46,6 +46,8 @@ import numpy as np
 
 from ...jit import device, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
+from .ao import ao_node
+from .bevel import bevel_node
 from .bump import bump_point, undisplaced_point, with_normal
 from .closure_nodes import eval_closure_node
 from .color_nodes import eval_color_node
@@ -88,6 +90,8 @@ from .vector_nodes import eval_vector_node
 from .wireframe import wireframe_node
 
 _WIREFRAME = NODES["Wireframe"].code
+_BEVEL = NODES["Bevel"].code
+_AO = NODES["AmbientOcclusion"].code
 
 OP_END = 0
 OP_NODE = 1
@@ -154,13 +158,17 @@ def convert(regs, a, b, kind):
 
 
 @device
-def eval_row(ops, pc, regs, sd, tex, verts, tris):
+def eval_row(ops, pc, regs, sd, tex, verts, tris, local):
     """One value row: OP_NODE, OP_COPY or OP_CONVERT."""
     op = ops[pc, 0]
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if op == OP_NODE:
-        if a == _WIREFRAME:         # the one node that reads the triangle's corners
+        if a == _WIREFRAME:         # the nodes that read the triangles themselves
             wireframe_node(regs, b, c, sd, verts, tris)
+        elif a == _BEVEL:
+            bevel_node(regs, b, c, sd, tex, verts, tris, local)
+        elif a == _AO:
+            ao_node(regs, b, c, sd, tex, verts, tris, local)
         else:
             eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
     elif op == OP_COPY:
@@ -171,7 +179,7 @@ def eval_row(ops, pc, regs, sd, tex, verts, tris):
 
 
 @function
-def eval_values(ops, start, end, regs, sd, tex, verts, tris):
+def eval_values(ops, start, end, regs, sd, tex, verts, tris, local):
     """Run value rows [start, end) at ``sd``: the Height sub-graph of a Bump node, or the
     output's Displacement; a Bump node in there moves the point again from ``sd``."""
     point = sd
@@ -182,7 +190,7 @@ def eval_values(ops, start, end, regs, sd, tex, verts, tris):
             else:
                 point = region_point(ops, pc, regs, sd, tex, verts, tris)
         else:
-            eval_row(ops, pc, regs, point, tex, verts, tris)
+            eval_row(ops, pc, regs, point, tex, verts, tris, local)
 
 
 @device
@@ -195,14 +203,15 @@ def region_point(ops, pc, regs, sd, tex, verts, tris):
 
 
 @function
-def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
+def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
     """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`.
-    ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point
-    (not in ``tex``: every node function takes that, and a call copies its arrays)."""
+    ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point,
+    ``local`` the hierarchies (``subsurface.LocalBVH``) that Bevel and Ambient Occlusion nodes
+    trace (not in ``tex``: every node function takes that, and a call copies its arrays)."""
     res = NO_RESULT
     if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:
         surface, b = start + ops[start, 3], ops[start, 2]
-        eval_values(ops, start + 1, surface, regs, sd, tex, verts, tris)
+        eval_values(ops, start + 1, surface, regs, sd, tex, verts, tris, local)
         sd = with_normal(sd, regs[b], regs[b + 1], regs[b + 2])
         start = surface
     skip = start             # rows before it were run by eval_values
@@ -214,10 +223,10 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris):
             res = closure_row(ops, pc, regs, cl, sd, res)
         elif op == OP_BUMP:
             eval_values(ops, pc + 1, pc + ops[pc, 3], regs,
-                        region_point(ops, pc, regs, sd, tex, verts, tris), tex, verts, tris)
+                        region_point(ops, pc, regs, sd, tex, verts, tris), tex, verts, tris, local)
             skip = pc + ops[pc, 3] + 1
         else:
-            eval_row(ops, pc, regs, sd, tex, verts, tris)
+            eval_row(ops, pc, regs, sd, tex, verts, tris, local)
     return res
 
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..sampling import make_orthonormals
 from .data import OBJ_INVERSE, OBJ_MATRIX, ShadingData
 from .input_nodes import attribute, normal_to_object, normal_to_world, transform_direction, transform_point
 from .math_nodes import safe_normalize
@@ -54,18 +55,6 @@ _VD_MIDLEVEL = OFFSETS["VectorDisplacement"]["Midlevel"]
 _VD_SCALE = OFFSETS["VectorDisplacement"]["Scale"]
 _VD_SPACE = OFFSETS["VectorDisplacement"]["prop:space"]
 _VD_TANGENT = OFFSETS["VectorDisplacement"]["prop:attribute"]
-
-
-@device
-def make_orthonormals(nx, ny, nz):
-    """Cycles' make_orthonormals: a = normalize((1, 1, 1) x N) (or (-1, 1, 1) x N when the
-    components are equal), b = N x a."""
-    if nx != ny or nx != nz:
-        ax, ay, az = nz - ny, nx - nz, ny - nx
-    else:
-        ax, ay, az = nz - ny, nx + nz, -ny - nx
-    ax, ay, az = safe_normalize(ax, ay, az)
-    return ax, ay, az, ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
 
 
 @device
@@ -113,7 +102,7 @@ def bump_point(sd, verts, tris, width, axis):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u + du, sd.v + dv, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, sd.dp)
+                       sd.transmission_depth, sd.transparent_depth, sd.dp, sd.rng, sd.min_pdf)
 
 
 # A Bump node's state block on truly displaced meshes (register b of its ``OP_BUMP`` rows
@@ -183,7 +172,7 @@ def undisplaced_point(sd, verts, tris, regs, s, axis, tex):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, u + du, v + dv, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, dp)
+                       sd.transmission_depth, sd.transparent_depth, dp, sd.rng, sd.min_pdf)
 
 
 @device
@@ -193,7 +182,7 @@ def with_normal(sd, nx, ny, nz):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u, sd.v, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, sd.dp)
+                       sd.transmission_depth, sd.transparent_depth, sd.dp, sd.rng, sd.min_pdf)
 
 
 @function

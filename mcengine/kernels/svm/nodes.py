@@ -348,14 +348,15 @@ SHADER_ROUTING = {
 
 # -- value nodes: families ------------------------------------------------------------------------
 FAMILY_INPUT = 1       # svm/input_nodes.py: coordinates, attributes, geometry, constants;
-                       # svm/wireframe.py: Wireframe
+                       # svm/wireframe.py: Wireframe; svm/ao.py: Ambient Occlusion
 FAMILY_MATH = 2        # svm/math_nodes.py: Math, Vector Math, Map Range, converters
 FAMILY_COLOR = 3       # svm/color_nodes.py: Mix, ColorRamp, curves, colour adjustments
 FAMILY_TEXTURE = 4     # svm/texture_nodes.py: procedural textures (401-449);
                        # svm/image_nodes.py: image textures (450-469)
 IMAGE_CODES = 450      # first code of the image nodes
 FAMILY_VECTOR = 5      # svm/vector_nodes.py: Mapping, Vector Rotate, Vector Transform, Normal
-FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump, Displacement, Vector Displacement
+FAMILY_NORMAL = 6      # svm/normal_nodes.py: Normal Map, Bump, Displacement, Vector Displacement;
+                       # svm/bevel.py: Bevel
 
 # Texture Coordinate outputs, in register order (also the TC_* codes of "prop:output"
 # of the single-output coordinate nodes the compiler inserts for implicit inputs).
@@ -401,6 +402,12 @@ VALUE_NODES = {
     # Wireframe reads the point's triangle (evaluated by ``svm.wireframe``, not by its family)
     "Wireframe": NodeSpec(115, (_f("Size", 0.01), _p("use_pixel_size", 0)), (_f("Fac", 0.0),),
                           False),
+    # Ambient Occlusion traces rays (evaluated by ``svm.ao``); "prop:global_distance" is the
+    # world's AO distance where a Distance of 0 is unlinked (Cycles' global radius), else -1
+    "AmbientOcclusion": NodeSpec(116, (_c("Color", WHITE), _f("Distance", 1.0), _v("Normal"),
+                                       _p("samples", 16), _p("inside", 0), _p("only_local", 0),
+                                       _p("global_distance", -1)),
+                                 (_c("Color", (0, 0, 0)), _f("AO", 0.0)), False),
     # -- math family: converters (svm/math_nodes.py)
     "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
                            _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),
@@ -547,6 +554,9 @@ VALUE_NODES = {
     "VectorDisplacement": NodeSpec(604, (_c("Vector", (0.8, 0.8, 0.8)), _f("Midlevel", 0.0), _f("Scale", 0.01),
                                          _p("space", SPACE_TANGENT), _p("attribute", -1)),
                                    (_v("Displacement", UNLINKED),), False),
+    # Bevel traces rays against its object (evaluated by ``svm.bevel``, not by its family)
+    "Bevel": NodeSpec(605, (_f("Radius", 0.05), _v("Normal"), _p("samples", 8)),
+                      (_v("Normal", UNLINKED),), False),
 }
 # The Bump node's three heights: at the point, at the point moved along dPdx and along dPdy.
 BUMP_HEIGHTS = ("Height", "Height_dx", "Height_dy")

@@ -272,6 +272,21 @@ def combine_material(name, first, second, fac=None):
     return material
 
 
+def diffuse_between(tree, output, factor, color_a, color_b, location=(-300.0, 0.0)):
+    """A Diffuse BSDF (roughness 0) into ``output``'s Surface, its colour a Mix (RGBA, factor
+    clamped, at ``location``) from ``color_a`` to ``color_b`` by the output socket
+    ``factor``."""
+    mix = shader_node(tree, "ShaderNodeMix", location=location, data_type="RGBA",
+                      clamp_factor=True)
+    sockets = {s.identifier: s for s in (*mix.inputs, *mix.outputs)}
+    sockets["A_Color"].default_value = (*color_a, 1.0)
+    sockets["B_Color"].default_value = (*color_b, 1.0)
+    tree.links.new(factor, sockets["Factor_Float"])
+    bsdf = shader_node(tree, "ShaderNodeBsdfDiffuse", roughness=0.0)
+    tree.links.new(sockets["Result_Color"], bsdf.inputs["Color"])
+    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+
+
 # --------------------------------------------------------------------------
 # Textures (written next to the scenes, in textures/, and read by relative path)
 # --------------------------------------------------------------------------

@@ -64,15 +64,7 @@ def _floor_material():
     material, tree, output = c._new_material("Floor")
     ao = c.shader_node(tree, "ShaderNodeAmbientOcclusion", location=(-600.0, 0.0), distance=0.6,
                        samples=16)
-    mix = c.shader_node(tree, "ShaderNodeMix", location=(-300.0, 0.0), data_type="RGBA",
-                        clamp_factor=True)
-    sockets = {s.identifier: s for s in (*mix.inputs, *mix.outputs)}
-    sockets["A_Color"].default_value = (0.15, 0.12, 0.1, 1.0)
-    sockets["B_Color"].default_value = (0.6, 0.6, 0.6, 1.0)
-    tree.links.new(ao.outputs["AO"], sockets["Factor_Float"])
-    bsdf = c.shader_node(tree, "ShaderNodeBsdfDiffuse", roughness=0.0)
-    tree.links.new(sockets["Result_Color"], bsdf.inputs["Color"])
-    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    c.diffuse_between(tree, output, ao.outputs["AO"], (0.15, 0.12, 0.1), (0.6, 0.6, 0.6))
     return material
 
 

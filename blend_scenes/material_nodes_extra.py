@@ -96,15 +96,8 @@ def _dented_material():
     normal = c.shader_node(tree, "ShaderNodeNormal", location=(-600.0, 300.0))
     normal.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
     tree.links.new(geometry.outputs["Normal"], normal.inputs["Normal"])
-    mix = c.shader_node(tree, "ShaderNodeMix", location=(-300.0, 200.0), data_type="RGBA",
-                        clamp_factor=True)
-    sockets = {s.identifier: s for s in (*mix.inputs, *mix.outputs)}
-    sockets["A_Color"].default_value = (0.75, 0.7, 0.6, 1.0)
-    sockets["B_Color"].default_value = (0.3, 0.5, 0.8, 1.0)
-    tree.links.new(normal.outputs["Dot"], sockets["Factor_Float"])
-    bsdf = c.shader_node(tree, "ShaderNodeBsdfDiffuse", roughness=0.0)
-    tree.links.new(sockets["Result_Color"], bsdf.inputs["Color"])
-    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    c.diffuse_between(tree, output, normal.outputs["Dot"], (0.75, 0.7, 0.6), (0.3, 0.5, 0.8),
+                      location=(-300.0, 200.0))
     return material
 
 

@@ -449,6 +449,23 @@ def facing_corners(normals, p, gx, gy, gz):
 
 
 @device
+def disk_axes(ngx, ngy, ngz, u):
+    """The frame (n, t, b) of a disk probe about a point of geometric normal ng, its axis n
+    picked by u as Cycles picks it: the normal for u < 1/2, else the tangent or the
+    bitangent of Cycles' frame (a quarter each), swapped with the normal.  Returns the
+    frame, the probabilities with which n, t and b are picked as axes, and u rescaled to
+    [0, 1).  Cycles' frame, not any other: the MIS over the three axes leaves out the other
+    axes' disk densities, so what the probes find depends on how the frame turns about ng."""
+    tx, ty, tz, bx, by, bz = make_orthonormals(ngx, ngy, ngz)
+    nx, ny, nz = ngx, ngy, ngz
+    if u < 0.5:
+        return nx, ny, nz, tx, ty, tz, bx, by, bz, 0.5, 0.25, 0.25, u * 2.0
+    if u < 0.75:
+        return tx, ty, tz, nx, ny, nz, bx, by, bz, 0.25, 0.5, 0.25, (u - 0.5) * 4.0
+    return bx, by, bz, tx, ty, tz, nx, ny, nz, 0.25, 0.25, 0.5, (u - 0.75) * 4.0
+
+
+@device
 def probe(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, key):
     """Every surface of object ``obj`` on the probe o + t d, 0 < t < tmax, nearest first: the
     first four, then (reservoir sampling with hashes of ``key``) a uniform subset of four, as
@@ -491,21 +508,7 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, p
     key's dimension set 0; the reservoir's choices beyond four surfaces are hashes.
     """
     u1, u2, u_resample, _ = sample_4d(sampler, wkey, 0, mask)
-    # Cycles' frame: the MIS over the three axes leaves out the other axes' disk densities,
-    # so what a probe finds depends on how the frame turns about the normal.
-    tx, ty, tz, bx, by, bz = make_orthonormals(ngx, ngy, ngz)
-    nx, ny, nz = ngx, ngy, ngz
-    if u2 < 0.5:
-        pick_n, pick_t, pick_b = 0.5, 0.25, 0.25
-        u2 *= 2.0
-    elif u2 < 0.75:
-        nx, ny, nz, tx, ty, tz = tx, ty, tz, nx, ny, nz
-        pick_n, pick_t, pick_b = 0.25, 0.5, 0.25
-        u2 = (u2 - 0.5) * 4.0
-    else:
-        nx, ny, nz, bx, by, bz = bx, by, bz, nx, ny, nz
-        pick_n, pick_t, pick_b = 0.25, 0.25, 0.5
-        u2 = (u2 - 0.75) * 4.0
+    nx, ny, nz, tx, ty, tz, bx, by, bz, pick_n, pick_t, pick_b, u2 = disk_axes(ngx, ngy, ngz, u2)
     disk_r, h = disk_sample(rr, rg, rb, u1)
     c, s = disk_r * math.cos(2.0 * math.pi * u2), disk_r * math.sin(2.0 * math.pi * u2)
     ox = px + nx * h + tx * c + bx * s

@@ -27,8 +27,8 @@ import math
 
 from ...jit import device, function
 from ..intersect import intersect_prim
-from ..sampling import branched_2d, make_orthonormals, node_key
-from ..subsurface import facing_corners, probe
+from ..sampling import branched_2d, node_key
+from ..subsurface import disk_axes, facing_corners, probe
 from .nodes import OFFSETS
 
 _RADIUS = OFFSETS["Bevel"]["Radius"]
@@ -93,19 +93,8 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
     sx = sy = sz = 0.0
     for s in range(samples):
         u1, u2 = branched_2d(sd.rng, s)
-        nx, ny, nz = sd.ngx, sd.ngy, sd.ngz
-        tx, ty, tz, bx, by, bz = make_orthonormals(nx, ny, nz)
-        if u1 < 0.5:
-            pick_n, pick_t, pick_b = 0.5, 0.25, 0.25
-            u1 *= 2.0
-        elif u1 < 0.75:
-            nx, ny, nz, tx, ty, tz = tx, ty, tz, nx, ny, nz
-            pick_n, pick_t, pick_b = 0.25, 0.5, 0.25
-            u1 = (u1 - 0.5) * 4.0
-        else:
-            nx, ny, nz, bx, by, bz = bx, by, bz, nx, ny, nz
-            pick_n, pick_t, pick_b = 0.25, 0.25, 0.5
-            u1 = (u1 - 0.75) * 4.0
+        nx, ny, nz, tx, ty, tz, bx, by, bz, pick_n, pick_t, pick_b, u1 = disk_axes(
+            sd.ngx, sd.ngy, sd.ngz, u1)
         disk_r = _cubic_radius(radius, u2)
         disk_pdf = _cubic_pdf(radius, disk_r)
         if not disk_pdf > 0.0:

@@ -253,7 +253,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         if plan.subsurface:
             walked += [i for i, mat in enumerate(scene.materials) if "subsurface" in surface_kinds(mat)]
         scene_ids = None
-        if materials_with_node(programs, "AmbientOcclusion"):
+        if set(materials_with_node(programs, "AmbientOcclusion")) & set(np.unique(mat_index).tolist()):
             visibility = scene.geometry.triangle_visibility()
             scene_ids = np.arange(len(tris), dtype=np.int32) if visibility is None else \
                 np.flatnonzero(visibility & VIS_SHADOW).astype(np.int32)

@@ -218,9 +218,10 @@ _FRAME_GEOMETRY_NODES = {"Wireframe": "the edges of their triangles",
 
 
 def warn_moving_frame_geometry(ctx, desc) -> None:
-    """Warn when moving objects use a material with a Wireframe or Bevel node: it reads their
-    triangles as they are at the frame's time (the evaluator reads the frame's vertices, the
-    Bevel node their hierarchy), where Cycles takes them at each ray's time."""
+    """Warn when moving objects use a material with a Wireframe or Bevel node, or move in a
+    scene where a material uses Ambient Occlusion: these read triangles as they are at the
+    frame's time (the evaluator reads the frame's vertices, Bevel and AO hierarchies built
+    from them), where Cycles takes them at each ray's time."""
     if desc.motion_blur is None:
         return
     g = desc.geometry
@@ -232,7 +233,8 @@ def warn_moving_frame_geometry(ctx, desc) -> None:
             from .mesh import listed
             ctx.warn(f"{kind} on moving objects ({listed(names)}): {what} as they are at the "
                      f"frame, not as they move during the shutter", f"{kind} under motion blur")
-    if any(n.type == "AmbientOcclusion" for m in desc.materials for n in m.nodes):
+    in_use = {k for k in np.unique(g.material_index).tolist() if k >= 0}
+    if any(n.type == "AmbientOcclusion" for k in in_use for n in desc.materials[k].nodes):
         names = [g.object_names[om.object] for om in desc.motion_blur.objects if moves(om)]
         if names:
             from .mesh import listed

@@ -47,7 +47,8 @@ MAX_STEPS = 256                  # Cycles' BSSRDF_MAX_BOUNCES
 SIMILARITY_LEVEL = 9             # steps with the real phase function (Cycles' similarity level)
 THROUGHPUT_EPSILON = 1e-6        # Cycles' VOLUME_THROUGHPUT_EPSILON
 MIN_ALPHA = 0.2                  # single-scattering albedo floor (the throughput compensates)
-DISK_MAX_HITS = 4                # surfaces a disk probe keeps (Cycles' BSSRDF_MAX_HITS)
+DISK_MAX_HITS = 4                # surfaces a disk probe keeps (Cycles' BSSRDF_MAX_HITS, and
+                                 # LOCAL_MAX_HITS for Bevel)
 _INV_2PI = 0.5 / math.pi
 _INV_4PI = 0.25 / math.pi
 

@@ -202,13 +202,13 @@ def test_vector_pass_keeps_deformation(scene, fake_session):
     np.testing.assert_allclose(om.positions[:, :, 2], np.repeat(heights, 4).reshape(3, 4), atol=1e-5)
 
 
-def _wireframe_material(name):
+def _wireframe_material(name, node="ShaderNodeWireframe", output="Fac"):
     import bpy
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
-    wire = nt.nodes.new("ShaderNodeWireframe")
-    nt.links.new(wire.outputs["Fac"], nt.nodes["Principled BSDF"].inputs["Roughness"])
+    wire = nt.nodes.new(node)
+    nt.links.new(wire.outputs[output], nt.nodes["Principled BSDF"].inputs["Roughness"])
     return mat
 
 
@@ -228,5 +228,26 @@ def test_wireframe_on_a_moving_object_is_warned(scene, fake_session):
     ob.data.materials.append(wire)
     assert warned() == ["Wireframe on moving objects ('Slider'): the edges of their triangles as "
                         "they are at the frame, not as they move during the shutter"]
+    scene.render.use_motion_blur = False
+    assert warned() == []
+
+
+def test_bevel_and_ambient_occlusion_with_moving_objects_are_warned(scene, fake_session):
+    """Bevel traces its object's hierarchy, Ambient Occlusion the scene's, both built from the
+    frame's triangles: a bevelled object that moves, and any moving object where a material
+    uses AO (every object may occlude it), are warned; nothing without motion blur."""
+    ob = _sliding_square(scene)
+    still = new_mesh_object("Still", SQUARE, [(0, 1, 2, 3)])
+    still.data.materials.append(_wireframe_material("Dirt", "ShaderNodeAmbientOcclusion", "AO"))
+    _motion_blur(scene)
+
+    def warned():
+        return [w for w in export_scene(fake_session).warnings
+                if w.startswith(("Bevel", "Ambient Occlusion"))]
+    assert warned() == ["Ambient Occlusion with moving objects ('Slider'): they occlude as they "
+                        "are at the frame, not as they move during the shutter"]
+    ob.data.materials.append(_wireframe_material("Edges", "ShaderNodeBevel", "Normal"))
+    assert warned()[0] == ("Bevel on moving objects ('Slider'): their surfaces' normals around "
+                           "the point as they are at the frame, not as they move during the shutter")
     scene.render.use_motion_blur = False
     assert warned() == []

@@ -28,7 +28,7 @@ import math
 from ...jit import device, function
 from ..intersect import intersect_prim
 from ..sampling import branched_2d, node_key
-from ..subsurface import disk_axes, facing_corners, probe
+from ..subsurface import DISK_MAX_HITS, disk_axes, facing_corners, probe
 from .nodes import OFFSETS
 
 _RADIUS = OFFSETS["Bevel"]["Radius"]
@@ -107,8 +107,8 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
         oz = sd.pz + nz * h + tz * c + bz * d
         count, p0, p1, p2, p3, _, _, _, _ = probe(local, verts, tris, obj, ox, oy, oz, -nx, -ny,
                                                   -nz, 2.0 * h, node_key(sd.rng, s))
-        scale = count / 4.0 if count > 4 else 1.0
-        for k in range(min(count, 4)):
+        scale = count / DISK_MAX_HITS if count > DISK_MAX_HITS else 1.0
+        for k in range(min(count, DISK_MAX_HITS)):
             p = p0 if k == 0 else p1 if k == 1 else p2 if k == 2 else p3
             t, b1, b2 = intersect_prim(ox, oy, oz, -nx, -ny, -nz, verts, tris, p)
             if not math.isfinite(t):

@@ -14,11 +14,16 @@ import numpy as np
 import pytest
 
 from mcengine.kernels.sampling import node_key
+from mcengine.kernels.state import VIS_ALL, VIS_CAMERA, VIS_SHADOW
 from mcengine.kernels.subsurface import build_local_bvh
 from mcengine.kernels.svm import OBJ_STRIDE, ShadingData
 from mcengine.kernels.svm.ao import ao_node
 from mcengine.kernels.svm.nodes import OFFSETS
+from mcengine.scene import Geometry, Link, Material, ShaderNode
+from mcengine.session import RenderSession
 from mcengine.shaders import NO_TEXTURES
+
+from .expect import assert_mean
 
 WALL = 1.0       # the wall's distance from the point (along +x)
 KEYS = 400       # shading points averaged (16 rays each)
@@ -96,3 +101,23 @@ def test_nothing_occludes_where_it_does_not_trace():
     assert _ao(0.0, keys=20)[0] == 1.0
     assert _ao(2.0, min_pdf=0.0, keys=20)[0] == 1.0
     assert _ao(2.0, keys=20)[0] < 1.0
+
+
+@pytest.mark.parametrize("hidden, expected", [(VIS_CAMERA, 0.25), (VIS_CAMERA | VIS_SHADOW, 1.0)])
+def test_a_rendered_floor_is_occluded_by_what_shadow_rays_see(hidden, expected):
+    """A render: an emissive floor whose colour is its AO (Distance 2) under a cover 1 m
+    above, hidden from camera rays. Cosine rays meet the cover within 2 m when their cosine
+    is above 1/2: the floor shows AO = 1/4. Hidden from shadow rays too (Cycles' AO rays are
+    opaque shadow rays), the cover leaves the scene's hierarchy: AO = 1."""
+    from .scenes import grid_plane, plane_scene
+    scene = plane_scene(None, samples=256, res=8, bounces=0)
+    scene.lights = []
+    floor, cover = grid_plane(200.0), grid_plane(200.0, z=1.0)[:, ::-1]
+    scene.geometry = Geometry.from_triangles(np.concatenate([floor, cover]), material_index=[0, 0, 1, 1],
+                                             object_index=[0, 0, 1, 1], object_names=["Floor", "Cover"])
+    scene.geometry.object_visibility = np.array([VIS_ALL, VIS_ALL & ~hidden], np.uint8)
+    glow = Material(nodes=[ShaderNode("AmbientOcclusion", {"Distance": 2.0}),
+                           ShaderNode("Emission", {"Color": Link(0, "Color"), "Strength": 1.0})],
+                    surface=Link(1, "Emission"))
+    scene.materials = [glow, Material(base_color=(0.0,) * 3)]
+    assert_mean(RenderSession(scene).run(), expected)

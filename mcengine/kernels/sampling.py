@@ -111,8 +111,9 @@ def exit_key(key, vertex):
 
 @device
 def node_key(key, vertex):
-    """Key of the numbers that ray-traced shader nodes (Bevel) draw at path vertex ``vertex``:
-    a hash of the path's key (its sample index included), so every sample has its own."""
+    """Key of the numbers that ray-traced shader nodes (Bevel, Ambient Occlusion) draw at path
+    vertex ``vertex``: a hash of the path's key (its sample index included), so every sample
+    has its own."""
     return mix64(key ^ (np.uint64(vertex + 1) * _K_NODES))
 
 

@@ -28,7 +28,7 @@ ShadingData = namedtuple("ShadingData", [
     "diffuse_depth", "glossy_depth", "transmission_depth", "transparent_depth",
     "dp",                      # the ray differential's footprint here (Cycles' compact sd->dP:
                                # dPdx, dPdy are dp times two unit tangents; 0: no differential)
-    "rng",                     # key of the numbers that ray-traced nodes (Bevel) draw here
+    "rng",                     # key of the numbers ray-traced nodes (Bevel, AO) draw here
     "min_pdf",                 # smallest BSDF pdf on the path so far (Cycles' min_ray_pdf);
                                # 0 where nodes trace no rays (shadow rays, light samples,
                                # displacement, the world), as Cycles' shader evaluations there

@@ -26,6 +26,7 @@ SCENES = (
     "light_point_large",
     "light_spot_shapes",
     "light_sun_wide",
+    "light_ies",
     "transforms",
     "instancing_modifiers",
     "camera_sensor_fit",

@@ -36,6 +36,7 @@ from .kernels.lights import (
     LT_SUN,
     light_set_columns,
     pack_lights,
+    pack_profiles,
 )
 from .kernels.motion import pack_motion
 from .kernels.passes import P_CRYPTO_ASSET, P_CRYPTO_OBJECT, P_OBJECT_ID, P_UV, P_VECTOR, PassData
@@ -160,7 +161,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
         verts=verts, tris=tris, normals=normals,
         mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
-        lamps=np.zeros((0, LIGHT_STRIDE)), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
+        lamps=np.zeros((0, LIGHT_STRIDE)), ies=np.zeros(1), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
         emit_cdf=np.zeros(1), emit_group=np.zeros((1, S_STRIDE)), emit_tree=no_tree(),
         tri_light=np.full(len(tris), -1, np.int32),
         tri_area=tri_area, tri_normal=tri_normal,
@@ -213,6 +214,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
 
     lamps, lamp_power = pack_lights(scene.lights, scene_radius)
+    ies = pack_profiles(scene.lights, lamps)
     cdf, lamp_pmf, emit_pmf, world_pmf = light_distribution(lamp_power, emit_power, world_power)
     emit_cdf = np.concatenate([[0.0], np.cumsum(emit_pmf)])
     if emit_cdf[-1] > 0:
@@ -263,7 +265,7 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
             np.unique(tri_object[np.isin(mat_index, walked)]), scene_ids=scene_ids))
 
     x0, y0, x1, y1 = film.window
-    sc = sc._replace(lamps=lamps, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,
+    sc = sc._replace(lamps=lamps, ies=ies, light_cdf=cdf, emit_tri=emit_tri, emit_pmf=emit_pmf,
                      emit_cdf=emit_cdf, emit_group=emit_group, emit_tree=emit_tree,
                      tri_light=tri_light)
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from . import integrators, memory, samplers
 from .denoise import Denoising
+from .ies import IESProfile
 from .kernels.lights import LIGHT_SETS_ALL, MAX_LIGHT_SETS
 from .kernels.state import VIS_ALL
 from .passes import RenderPasses
@@ -426,6 +427,8 @@ class Light:
     visible_transmission: bool = True
     max_bounces: int = 1024
     light_sets: int = LIGHT_SETS_ALL  # light linking: the receivers' light sets it lights
+    ies: object = None               # mcengine.ies.IESProfile: its IES Texture's profile scales
+                                     # the strength along each direction (None: none)
     name: str = "Light"
 
 
@@ -958,6 +961,8 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
     for d in meta["lights"]:
         d = dict(d)
         d["matrix_world"] = np.array(d["matrix_world"], float)
+        if d.get("ies") is not None:
+            d["ies"] = IESProfile(**{k: _array_from_json(v) for k, v in d["ies"].items()})
         lights.append(Light(**{k: (tuple(v) if isinstance(v, list) and k != "matrix_world" else v)
                                for k, v in d.items()}))
     cam = dict(meta["camera"])
@@ -1022,7 +1027,10 @@ def _plain(d: dict) -> dict:
 
 
 def _light_meta(li: Light) -> dict:
-    d = _plain(dataclasses.asdict(li))
+    d = _plain(dataclasses.asdict(dataclasses.replace(li, ies=None)))
+    if li.ies is not None:
+        d["ies"] = {name: _json_array(getattr(li.ies, name))
+                    for name in ("h_angles", "v_angles", "intensity")}
     d["strength"] = [float(x) for x in d["strength"]]
     d["light_sets"] = int(d["light_sets"])
     return {k: (float(v) if isinstance(v, np.floating) else v) for k, v in d.items()}

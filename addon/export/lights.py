@@ -6,8 +6,12 @@ uses as ``Light.temperature_color``), times the emission of the lamp's node tree
 that is constant (the default is white x 1): an Emission shader, also with value nodes
 (Blackbody, RGB, Math, ...) and Mix or Add Shaders on constant inputs, compiled and folded
 as a material's graph is (``mcengine.shaders``; a Light Falloff's Quadratic without Smooth
-is its Strength).  A tree that varies over the lamp (Light Falloff's other outputs or with
-Smooth, IES Texture, textures on its coordinates) is warned and left out.
+is its Strength).  An IES Texture (its Vector unlinked: the direction the light leaves the
+lamp, as Cycles reads it) whose Factor the emission is proportional to becomes the lamp's
+profile (``mcengine.ies``; the tree folded with the Factor at 1 is the strength); a file
+Cycles cannot read gives 100 in every direction, as in Cycles, warned.  A tree that varies
+over the lamp otherwise (Light Falloff's other outputs or with Smooth, an IES Texture used
+otherwise, textures on its coordinates) is warned and left out.
 
 Shadow casting is ``light.use_shadow``; MIS and max bounces come from
 ``light.cycles``; the camera/diffuse/glossy/transmission visibility from the
@@ -23,8 +27,12 @@ irradiance needs no change.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
+import bpy
 import numpy as np
 
+from mcengine.ies import FAILED_VALUE, IESError, parse_ies
 from mcengine.kernels.lights import LIGHT_SETS_ALL
 from mcengine.scene import Light
 
@@ -55,7 +63,7 @@ def export_light(ctx, ob, matrix_world, name: str,
         ctx.warn(f"light '{name}' is a light portal: portals are not supported yet; skipped "
                  f"(portals add no light, only less noise, in Cycles)", "light portals")
         return None
-    strength = _strength(ctx, data, name)
+    strength, profile = _strength(ctx, data, name)
     if not np.all(np.isfinite(strength)):
         ctx.warn(f"light '{name}': strength {strength} is not finite; skipped", "non-finite light")
         return None
@@ -76,6 +84,7 @@ def export_light(ctx, ob, matrix_world, name: str,
         visible_glossy=bool(ob.visible_glossy),
         visible_transmission=bool(ob.visible_transmission),
         light_sets=int(light_sets),
+        ies=profile,
     )
     if data.type in ("POINT", "SPOT"):
         light.radius = float(data.shadow_soft_size) * s
@@ -99,26 +108,31 @@ def export_light(ctx, ob, matrix_world, name: str,
 
 
 def _strength(ctx, data, name) -> tuple:
-    """color x energy x 2**exposure (x temperature colour) (x constant node emission)."""
+    """(color x energy x 2**exposure (x temperature colour) (x node emission), IES profile)."""
     rgb = np.array(data.color[:3], np.float64) * data.energy * 2.0 ** data.exposure
     if data.use_temperature:
         rgb *= np.array(data.temperature_color[:3], np.float64)
-    rgb *= _node_factor(ctx, data, name)
-    return tuple(float(x) for x in rgb)
+    factor, profile = _node_factor(ctx, data, name)
+    rgb *= factor
+    return tuple(float(x) for x in rgb), profile
 
 
-def _node_factor(ctx, data, name) -> np.ndarray:
-    """Colour factor of the lamp's node tree (ones without one, as Cycles evaluates it)."""
+def _node_factor(ctx, data, name) -> tuple:
+    """Colour factor of the lamp's node tree (ones without one, as Cycles evaluates it) and
+    the IES profile it carries (None: none)."""
     tree = data.node_tree if data.use_nodes else None
     if tree is None:
-        return np.ones(3)
+        return np.ones(3), None
     out = tree.get_output_node("CYCLES")
     shader = linked_node(out.inputs["Surface"]) if out is not None else None
     if shader is None:
-        return np.zeros(3)  # an empty light shader emits nothing in Cycles
+        return np.zeros(3), None  # an empty light shader emits nothing in Cycles
     constant = _constant_emission(ctx, out)
     if constant is not None:
-        return constant
+        return constant, None
+    profiled = _ies_emission(ctx, data, tree, out, name)
+    if profiled is not None:
+        return profiled
     what = f"{shader.label or shader.name} shader"
     if shader.bl_idname == "ShaderNodeEmission":
         linked = [(linked_node(s), s.name) for s in (shader.inputs["Color"], shader.inputs["Strength"])
@@ -126,13 +140,69 @@ def _node_factor(ctx, data, name) -> np.ndarray:
         what = ", ".join(f"{src.label or src.name} into Emission '{sock}'" for src, sock in linked)
     ctx.warn(f"light '{name}': light node tree ({what}) not supported yet; rendered without "
              f"its node tree (Emission strength 1)", "light nodes")
-    return np.ones(3)
+    return np.ones(3), None
 
 
-def _constant_emission(ctx, out) -> np.ndarray | None:
+def _constant_emission(ctx, out, constants=None) -> np.ndarray | None:
     """The emission of a light's output node when its graph folds to constants (None when it
-    varies over the lamp or holds nodes MC Engine does not evaluate)."""
+    varies over the lamp or holds nodes MC Engine does not evaluate); ``constants``: nodes
+    read as constants (``GraphReader``)."""
     from mcengine.shaders import ShaderTable
 
-    material = surface_graph(ctx, out.inputs["Surface"])
+    material = surface_graph(ctx, out.inputs["Surface"], constants)
     return None if material is None else ShaderTable([material]).constant_emission(0)
+
+
+def _ies_emission(ctx, data, tree, out, name) -> tuple | None:
+    """(strength factor, profile) of a lamp tree whose one IES Texture scales its emission
+    (None: the tree is not of that form; the caller warns).
+
+    The tree is folded with the node's Factor read as a constant x: it must give x times
+    what it gives at 1 (checked at 0, 1 and beyond the profile's peak), so that the profile
+    times the Factor-1 emission is the lamp's emission in every direction.
+    """
+    nodes = [n for n in tree.nodes if n.bl_idname == "ShaderNodeTexIES" and not n.mute
+             and any(s.is_linked for s in n.outputs)]
+    if len(nodes) != 1:
+        return None
+    node = nodes[0]
+    label = node.label or node.name
+    if node.inputs["Vector"].is_linked or node.inputs["Strength"].is_linked:
+        ctx.warn(f"light '{name}': IES Texture '{label}' with a linked Vector or Strength is not "
+                 f"supported yet; rendered without its node tree (Emission strength 1)", "light nodes")
+        return np.ones(3), None
+    strength = float(node.inputs["Strength"].default_value)
+    key = node.as_pointer()
+    try:
+        profile = parse_ies(_ies_text(node, data))
+    except (IESError, OSError) as exc:
+        ctx.warn(f"light '{name}': IES Texture '{label}' could not be read ({exc}); rendered as "
+                 f"Cycles renders it, {FAILED_VALUE:g} x Strength in every direction", "IES files")
+        folded = _constant_emission(ctx, out, {key: FAILED_VALUE * strength})
+        return None if folded is None else (folded, None)
+    at_one = _constant_emission(ctx, out, {key: 1.0})
+    at_zero = _constant_emission(ctx, out, {key: 0.0})
+    x = max(2.0, 4.0 * profile.peak * abs(strength))
+    at_x = _constant_emission(ctx, out, {key: x})
+    if at_one is None or at_zero is None or at_x is None:
+        return None
+    scale = float(np.abs(at_x).max()) + 1e-300
+    if np.abs(at_zero).max() > 1e-9 * scale or np.abs(at_x - x * at_one).max() > 1e-6 * scale:
+        ctx.warn(f"light '{name}': the emission is not proportional to IES Texture '{label}' "
+                 f"(not supported yet); rendered without its node tree (Emission strength 1)",
+                 "light nodes")
+        return np.ones(3), None
+    return at_one * strength, profile
+
+
+def _ies_text(node, data) -> bytes:
+    """The IES file's text as Cycles reads it: the Text's lines each ended by a newline
+    (mode Internal), or the file (External; '//' from the .blend's folder, or its library's)."""
+    if node.mode == "EXTERNAL":
+        path = bpy.path.abspath(node.filepath, library=data.library)
+        if not node.filepath:
+            raise IESError("no file given")
+        return Path(path).read_bytes()
+    if node.ies is None:
+        raise IESError("no text data-block given")
+    return "".join(line.body + "\n" for line in node.ies.lines).encode("utf-8")

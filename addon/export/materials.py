@@ -113,10 +113,11 @@ def convert_material(ctx, material) -> Material:
     return result
 
 
-def surface_graph(ctx, socket) -> Material | None:
+def surface_graph(ctx, socket, constants=None) -> Material | None:
     """The shader graph feeding ``socket`` (a lamp's output Surface) as a material of that
-    graph; None when nothing feeds it or it holds nodes MC Engine does not evaluate."""
-    graph = _MaterialGraph(ctx)
+    graph; None when nothing feeds it or it holds nodes MC Engine does not evaluate.
+    ``constants``: nodes read as constants (``GraphReader``)."""
+    graph = _MaterialGraph(ctx, constants)
     surface = graph.shader(socket)
     if surface is None or graph.items:
         return None

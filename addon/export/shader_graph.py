@@ -140,10 +140,14 @@ class GraphReader:
     ----------
     ctx : ExportContext
         Gives the unit scale to data-block properties.
+    constants : dict, optional
+        Nodes read as constants: {node.as_pointer(): value}, the value every output of the
+        node gives (a lamp's IES Texture, whose Factor the lamp's profile carries).
     """
 
-    def __init__(self, ctx):
+    def __init__(self, ctx, constants=None):
         self.ctx = ctx
+        self.constants = constants or {}
         self.nodes: list[ShaderNode] = []
         self._index: dict = {}
         self.items: list[str] = []
@@ -219,6 +223,8 @@ class GraphReader:
                 return None       # an implicit texture coordinate, as Cycles fills it
             return _constant(got, socket.type)
         target = out.node
+        if target.as_pointer() in self.constants:
+            return _constant(self.constants[target.as_pointer()], socket.type)
         kind = node_type(target)
         spec = NODES.get(kind)
         feature = f"{kind} node"

@@ -41,6 +41,7 @@ from .lights import (
     LT_AREA,
     LT_SPOT,
     area_spread,
+    lamp_profile,
     spot_attenuation,
 )
 from .sampling import cosine_hemisphere, disk_concentric, orthonormal_basis, uniform_cone
@@ -108,8 +109,9 @@ def _around(ax, ay, az, x, y, z):
 
 
 @device
-def sample_emission(lamps, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u4):
-    """A lamp picked by power, a point on it and a direction (an :class:`Emission`)."""
+def sample_emission(lamps, ies, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u4):
+    """A lamp picked by power, a point on it and a direction (an :class:`Emission`), its
+    power weighted by the lamp's IES profile along the direction."""
     if emit_cdf.shape[0] < 2 or not emit_cdf[emit_cdf.shape[0] - 1] > 0.0:
         return _none()
     idx = int(pick_light(emit_cdf, u_pick))
@@ -134,6 +136,7 @@ def sample_emission(lamps, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u4):
             return _none()
         dx, dy, dz = _around(-lamps[idx, L_AZ], -lamps[idx, L_AZ + 1], -lamps[idx, L_AZ + 2], x, y, z)
         k = area_spread(lamps, idx, z) * math.pi * area / pmf   # L cos / (pmf / A * cos / pi)
+        k *= lamp_profile(lamps, ies, idx, dx, dy, dz)
         return Emission(True, idx, px, py, pz, dx, dy, dz, lamps[idx, L_RADIANCE] * k,
                         lamps[idx, L_RADIANCE + 1] * k, lamps[idx, L_RADIANCE + 2] * k)
     # A point: uniform directions over the sphere, or over the cone bounding the spot.
@@ -145,5 +148,6 @@ def sample_emission(lamps, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u4):
         dx, dy, dz = x, y, z
     att = spot_attenuation(lamps, idx, dx, dy, dz) if int(lamps[idx, L_TYPE]) == LT_SPOT else 1.0
     k = att * 2.0 * math.pi * omc / pmf                      # I / (pmf * pdf_dir)
+    k *= lamp_profile(lamps, ies, idx, dx, dy, dz)
     return Emission(True, idx, cx, cy, cz, dx, dy, dz, lamps[idx, L_RADIANCE] * k,
                     lamps[idx, L_RADIANCE + 1] * k, lamps[idx, L_RADIANCE + 2] * k)

@@ -278,7 +278,7 @@ def pick_light_local(lamps, group, has_group, world, recv, u):
 
 
 @device
-def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+def lamps_on_segment(lamps, ies, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
                      mp, mis_total, transparent_left, light_set):
     """Light from lamps the ray passes through before t_hit (lamps do not block rays), of
     those that light ``light_set`` (the receiver the ray left; -1: every lamp).
@@ -304,7 +304,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
                 continue
             if not lamp_lights(lamps, li, light_set):
                 continue
-            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, t_hit,
+            tl, lr, lg, lb, lpdf = intersect_lamp(lamps, ies, li, ox, oy, oz, dx, dy, dz, t_hit,
                                                   mp[0], mp[1], mp[2])
             if tl > last_t and tl < t_hit:
                 n_hits += 1
@@ -327,7 +327,7 @@ def lamps_on_segment(lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_m
 
 
 @device
-def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total, light_set):
+def sun_light(lamps, ies, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total, light_set):
     """Light from suns with an angle, seen along an escaped ray (MIS-weighted), of those that
     light ``light_set`` (-1: every sun)."""
     r = g = b = 0.0
@@ -339,7 +339,7 @@ def sun_light(lamps, dx, dy, dz, flags, mis_pdf, pmf_mode, mp, mis_total, light_
             continue
         if not lamp_lights(lamps, li, light_set):
             continue
-        lr, lg, lb, lpdf = sun_radiance(lamps, li, dx, dy, dz)
+        lr, lg, lb, lpdf = sun_radiance(lamps, ies, li, dx, dy, dz)
         if lpdf > 0.0:
             w = 1.0
             if not (flags & PF_MIS_SKIP):
@@ -410,7 +410,7 @@ def sample_light(sc, idx, pmf, hx, hy, hz, bounce, u1, u2, time):
         lflags = int(lamps[idx, L_FLAGS])
         if bounce > lamps[idx, L_MAX_BOUNCES]:
             return _no_light()
-        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamps, idx, hx, hy, hz, u1, u2)
+        wix, wiy, wiz, dist, lr, lg, lb, pdf = sample_lamp(lamps, sc.ies, idx, hx, hy, hz, u1, u2)
         use_mis = (lflags & LF_USE_MIS) != 0
         if pdf > 0.0:
             pdf_l = pmf * pdf

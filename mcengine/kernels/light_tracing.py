@@ -195,7 +195,7 @@ def start_light_paths(pixels, spp, sample_base, st, sc, cfg, emit_cdf, emit_pmf,
         for j in range(spp):
             key = light_key(path_key(cfg[CFG_SEED], global_pixel, sample_base[pix] + j))
             # The lamp's numbers take the camera's dimension sets (a light path has none).
-            em = sample_emission(sc.lamps, emit_cdf, emit_pmf, cones, rand(key, 0), rand(key, 1),
+            em = sample_emission(sc.lamps, sc.ies, emit_cdf, emit_pmf, cones, rand(key, 0), rand(key, 1),
                                  rand(key, 2), rand(key, 3), rand(key, 4))
             if not em.ok or (em.br == 0.0 and em.bg == 0.0 and em.bb == 0.0):
                 continue

@@ -27,7 +27,12 @@ Per lamp type (Cycles 5.0, intern/cycles/kernel/light/ and scene/light.cpp):
   it a spread lets reach the point) is sampled uniformly in solid angle from
   points near it (as Cycles samples it from everywhere), uniformly in area from
   farther ones and for an ellipse;
-* emissive triangles: radiance colour x strength on both sides.
+* emissive triangles: radiance colour x strength on both sides;
+* any lamp with an IES profile (a lamp node tree whose IES Texture's Factor scales its
+  emission, ``mcengine.ies``): its radiance times the profile along the direction the light
+  leaves the sampled point of the lamp, taken into the lamp's frame by the transpose of its
+  world matrix (Cycles' lamp shader reads the incoming direction as a normal in object
+  space); sampling and light picking do not see the profile, as in Cycles.
 
 Lamps are transparent to rays: a ray that passes through a lamp collects its
 light and goes on (Cycles counts it as a transparent bounce).  Shadow rays
@@ -40,6 +45,7 @@ import math
 import numpy as np
 
 from ..jit import device
+from .ies import ies_direction
 from .sampling import disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf
 
 LT_POINT = 0
@@ -71,7 +77,9 @@ L_MAX_BOUNCES = 37
 L_PMF = 38           # probability of picking this lamp for NEE (by power, scene-wide)
 L_IMPORTANCE = 39    # scale of the irradiance estimate that picks lights per shading point
 L_LIGHT_SETS = 40    # 2: light linking, the receivers' light sets it lights (light_set_columns)
-LIGHT_STRIDE = 42
+L_IES = 42           # 1 + the offset of its IES profile in the profiles' array (kernels/ies.py); 0: none
+L_IES_TFM = 43       # 9: the columns of its world matrix's 3x3 (scale included): local = M^T d
+LIGHT_STRIDE = 52
 
 # Light linking (Blender's light sets, as Cycles reads them): a receiver belongs to one light
 # set (0: the default set of unlinked objects) and an emitter lights a mask of light sets.
@@ -158,6 +166,7 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
         row[L_MAX_BOUNCES] = li.max_bounces
         row[L_LIGHT_SETS:L_LIGHT_SETS + 2] = light_set_columns([li.light_sets])[0]
         row[L_SPREAD_TAN] = -1.0
+        row[L_IES_TFM:L_IES_TFM + 9] = m[:3, :3].T.reshape(-1)
         # Negative strengths remove light, as in Cycles; lights are picked by |strength|.
         magnitude = float(np.abs(strength).mean())
         if li.type in ("POINT", "SPOT"):
@@ -217,6 +226,38 @@ def pack_lights(lights, scene_radius: float) -> tuple[np.ndarray, np.ndarray]:
                 row[L_SPREAD_NORM] = _spread_normalisation(half)
         row[L_FLAGS] = flags
     return table, power
+
+
+def pack_profiles(lights, table) -> np.ndarray:
+    """The lamps' IES profiles as the kernels read them (``kernels/ies.py``), each once, and
+    1 + their offsets in ``table[:, L_IES]`` (0 stays for lamps without one)."""
+    blocks, offsets, size = [], {}, 0
+    for i, li in enumerate(lights):
+        profile = li.ies
+        if profile is None:
+            continue
+        if id(profile) not in offsets:
+            offsets[id(profile)] = size
+            block = profile.packed()
+            blocks.append(block)
+            size += len(block)
+        table[i, L_IES] = 1 + offsets[id(profile)]
+    return np.concatenate(blocks) if blocks else np.zeros(1)
+
+
+@device
+def lamp_profile(lamps, ies, li, dx, dy, dz):
+    """The factor of lamp li's IES profile for light leaving it along (dx, dy, dz) (1 without
+    a profile): the direction taken into the lamp's frame as Cycles takes it, by the
+    transpose of the world matrix (a normal's transform), then looked up."""
+    ofs = int(lamps[li, L_IES]) - 1
+    if ofs < 0:
+        return 1.0
+    t = L_IES_TFM
+    x = lamps[li, t] * dx + lamps[li, t + 1] * dy + lamps[li, t + 2] * dz
+    y = lamps[li, t + 3] * dx + lamps[li, t + 4] * dy + lamps[li, t + 5] * dz
+    z = lamps[li, t + 6] * dx + lamps[li, t + 7] * dy + lamps[li, t + 8] * dz
+    return ies_direction(ies, ofs, x, y, z)
 
 
 @device
@@ -470,15 +511,27 @@ def _area_sample(lamps, li, px, py, pz, a, b, pdf, area):
 
 
 @device
-def sample_lamp(lamps, li, px, py, pz, u1, u2):
+def sample_lamp(lamps, ies, li, px, py, pz, u1, u2):
     """Sample lamp radiance arriving at p.
 
     Returns ``(wix, wiy, wiz, dist, Lr, Lg, Lb, pdf)``: the unit direction
     to the light, the distance to the sampled point (``inf`` for suns), the
-    radiance arriving along wi (attenuations included) and the solid-angle
-    pdf of wi.  ``pdf == 0`` with a non-zero L means a delta light whose L is
-    already the irradiance-equivalent (L/pdf term); ``L == 0`` means no light.
+    radiance arriving along wi (attenuations and the IES profile included) and
+    the solid-angle pdf of wi.  ``pdf == 0`` with a non-zero L means a delta
+    light whose L is already the irradiance-equivalent (L/pdf term); ``L == 0``
+    means no light.  A profile is read along -wi, from the sampled point of the
+    lamp (Cycles' wi of the lamp's shader); it does not change the sampling.
     """
+    wx, wy, wz, dist, lr, lg, lb, pdf = _sample_lamp(lamps, li, px, py, pz, u1, u2)
+    if lamps[li, L_IES] > 0.0:
+        f = lamp_profile(lamps, ies, li, -wx, -wy, -wz)
+        lr, lg, lb = lr * f, lg * f, lb * f
+    return wx, wy, wz, dist, lr, lg, lb, pdf
+
+
+@device
+def _sample_lamp(lamps, li, px, py, pz, u1, u2):
+    """:func:`sample_lamp` without the IES profile."""
     typ = int(lamps[li, L_TYPE])
     if typ == LT_SUN:
         azx, azy, azz = lamps[li, L_AZ], lamps[li, L_AZ + 1], lamps[li, L_AZ + 2]
@@ -602,14 +655,24 @@ def lamp_cone_omc(r, d2):
 
 
 @device
-def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
+def intersect_lamp(lamps, ies, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
     """A ray through a lamp: ``(t, Lr, Lg, Lb, pdf)``, t = inf if it misses.
 
     ``pdf`` is the solid-angle pdf with which :func:`sample_lamp` would pick
     this direction from the ray's vertex v (the surface point the ray left,
-    before its origin was offset), for MIS.  Suns are handled by
-    :func:`sun_radiance` on escaped rays.
+    before its origin was offset), for MIS.  The radiance includes the IES
+    profile along -d.  Suns are handled by :func:`sun_radiance` on escaped rays.
     """
+    t, lr, lg, lb, pdf = _intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz)
+    if lamps[li, L_IES] > 0.0 and t < math.inf:
+        f = lamp_profile(lamps, ies, li, -dx, -dy, -dz)
+        lr, lg, lb = lr * f, lg * f, lb * f
+    return t, lr, lg, lb, pdf
+
+
+@device
+def _intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
+    """:func:`intersect_lamp` without the IES profile."""
     typ = int(lamps[li, L_TYPE])
     if typ == LT_SUN:
         return math.inf, 0.0, 0.0, 0.0, 0.0
@@ -683,11 +746,14 @@ def intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
 
 
 @device
-def sun_radiance(lamps, li, dx, dy, dz):
-    """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d."""
+def sun_radiance(lamps, ies, li, dx, dy, dz):
+    """(Lr, Lg, Lb, pdf) of a sun with angle > 0 seen along the escaped direction d (its
+    IES profile read along -d)."""
     omc = lamps[li, L_SUN_OMC]
     if omc <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     if 1.0 - (dx * lamps[li, L_AZ] + dy * lamps[li, L_AZ + 1] + dz * lamps[li, L_AZ + 2]) > omc:
         return 0.0, 0.0, 0.0, 0.0
-    return lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2], uniform_cone_pdf(omc)
+    f = lamp_profile(lamps, ies, li, -dx, -dy, -dz)
+    return (f * lamps[li, L_RADIANCE], f * lamps[li, L_RADIANCE + 1], f * lamps[li, L_RADIANCE + 2],
+            uniform_cone_pdf(omc))

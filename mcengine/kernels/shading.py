@@ -258,7 +258,7 @@ def light_from_lamps(sc, cfg, fcfg, stats, out, row, beta, i, ox, oy, oz, dx, dy
     light ``light_set`` count (the receiver the ray left, light linking; -1: every lamp).
     """
     lr, lg, lb, passed = lamps_on_segment(
-        sc.lamps, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
+        sc.lamps, sc.ies, ox, oy, oz, dx, dy, dz, t_hit, flags, mis_pdf, pmf_mode,
         mp, mis_total, cfg[CFG_MAX_TRANSPARENT] - transparent, light_set)
     if passed:
         add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg, stats)
@@ -313,7 +313,7 @@ def light_from_suns(sc, cfg, fcfg, stats, out, row, beta, i, dx, dy, dz, flags, 
     """The suns' part of ``light_from_background``: suns with an angle seen by the ray (those
     that light ``light_set``; -1: all)."""
     if sc.lamps.shape[0] and cfg[CFG_LAMPS_HIT]:
-        lr, lg, lb = sun_light(sc.lamps, dx, dy, dz, flags, mis_pdf, pmf_mode,
+        lr, lg, lb = sun_light(sc.lamps, sc.ies, dx, dy, dz, flags, mis_pdf, pmf_mode,
                                mp, mis_total, light_set)
         if lr != 0.0 or lg != 0.0 or lb != 0.0:
             add_light(out, row, beta[i, 0] * lr, beta[i, 1] * lg, beta[i, 2] * lb, direct, fcfg,

@@ -91,6 +91,7 @@ SceneData = namedtuple("SceneData", [
     "mat_emission",  # (M, 3) f64    emitted radiance of material m as a light (no layering)
     "mat_flags",     # (M,) int32    MF_* bits
     "lamps",         # (NL, LIGHT_STRIDE) f64
+    "ies",           # (K,) f64      the lamps' IES profiles (lights.pack_profiles, kernels/ies.py)
     "light_cdf",     # (NL + NE + 1,) f64  NEE light distribution
     "emit_tri",      # (NE,) int32  emissive triangle ids
     "emit_pmf",      # (NE,) f64    their NEE probabilities

@@ -173,6 +173,80 @@ def test_light_falloff_in_a_lamp_tree(scene, fake_session):
     assert any("light node tree (Light Falloff into Emission 'Strength')" in w for w in warnings)
 
 
+IES_TEXT = ("IESNA:LM-63-2002\n[TEST] export\nTILT=NONE\n1 -1 2 3 1 1 2 0 0 0\n1 1 0\n"
+            "0 45 90\n0\n100 50 0\n")
+
+
+def _ies_lamp(scene, mode="INTERNAL", source=None):
+    """A point lamp whose IES Texture's Factor, times 3 (a Math node), is the Strength."""
+    ob = lamp(scene, "POINT", energy=10.0)
+    ob.data.use_nodes = True
+    tree = ob.data.node_tree
+    ies = tree.nodes.new("ShaderNodeTexIES")
+    ies.mode = mode
+    if mode == "INTERNAL":
+        text = bpy.data.texts.new("profile.ies")
+        text.write(IES_TEXT if source is None else source)
+        ies.ies = text
+    else:
+        ies.filepath = source
+    times = tree.nodes.new("ShaderNodeMath")
+    times.operation = "MULTIPLY"
+    times.inputs[1].default_value = 3.0
+    tree.links.new(ies.outputs["Fac"], times.inputs[0])
+    tree.links.new(times.outputs[0], tree.nodes["Emission"].inputs["Strength"])
+    return ob, ies, times
+
+
+def test_an_ies_texture_becomes_the_lamps_profile(scene, fake_session, tmp_path):
+    """The Factor scaling the emission: the tree at Factor 1 times the IES node's Strength is
+    the lamp's strength, the file (a Text, or a file by path) its profile."""
+    from mcengine.ies import CANDELA_TO_WATTS
+    ob, ies, times = _ies_lamp(scene)
+    ies.inputs["Strength"].default_value = 0.5
+    li, warnings = only_light(fake_session)
+    assert li.strength == pytest.approx((15, 15, 15))
+    assert not any("IES" in w or "light node" in w for w in warnings)
+    np.testing.assert_allclose(li.ies.intensity[0], np.float32([200, 100, 0]) * np.float32(CANDELA_TO_WATTS),
+                               rtol=1e-6)     # the candela multiplier 2
+    path = tmp_path / "profile.ies"
+    path.write_text(IES_TEXT.replace("100 50 0", "10 5 0"))
+    ies.mode, ies.filepath = "EXTERNAL", str(path)
+    li, warnings = only_light(fake_session)
+    assert li.ies.intensity[0, 0] == pytest.approx(20 * CANDELA_TO_WATTS, rel=1e-6)
+    assert not any("IES" in w or "light node" in w for w in warnings)
+
+
+def test_ies_textures_cycles_cannot_read_give_100_and_a_warning(scene, fake_session, tmp_path):
+    ob, ies, _ = _ies_lamp(scene, "EXTERNAL", str(tmp_path / "missing.ies"))
+    li, warnings = only_light(fake_session)
+    assert li.ies is None and li.strength == pytest.approx((3000, 3000, 3000))
+    assert any(w.startswith("light 'Lamp': IES Texture 'IES Texture' could not be read (") and
+               w.endswith("rendered as Cycles renders it, 100 x Strength in every direction")
+               for w in warnings), warnings
+    ies.mode, ies.ies = "INTERNAL", bpy.data.texts.new("empty")
+    li, warnings = only_light(fake_session)
+    assert li.ies is None and li.strength == pytest.approx((3000, 3000, 3000))
+    assert any("could not be read (no TILT= line" in w for w in warnings)
+
+
+def test_an_ies_texture_used_otherwise_is_warned_and_left_out(scene, fake_session):
+    """Not proportional to the Factor (Add instead of Multiply), or with a linked Vector: the
+    tree is left out (Emission strength 1), warned."""
+    ob, ies, times = _ies_lamp(scene)
+    times.operation = "ADD"
+    li, warnings = only_light(fake_session)
+    assert li.ies is None and li.strength == pytest.approx((10, 10, 10))
+    assert ("light 'Lamp': the emission is not proportional to IES Texture 'IES Texture' (not "
+            "supported yet); rendered without its node tree (Emission strength 1)") in warnings
+    times.operation = "MULTIPLY"
+    coords = ob.data.node_tree.nodes.new("ShaderNodeTexCoord")
+    ob.data.node_tree.links.new(coords.outputs["Normal"], ies.inputs["Vector"])
+    li, warnings = only_light(fake_session)
+    assert li.ies is None and li.strength == pytest.approx((10, 10, 10))
+    assert any("IES Texture 'IES Texture' with a linked Vector or Strength" in w for w in warnings)
+
+
 def test_portals_are_skipped_with_a_warning(scene, fake_session):
     lamp(scene, "AREA", name="Window").data.cycles.is_portal = True
     desc = export_scene(fake_session)

@@ -58,14 +58,17 @@ def receiver(lamps, x, y, t) -> tuple:
                  - t * r[L_AZ:L_AZ + 3])
 
 
+_NO_IES = np.zeros(1)     # the lamp has no IES profile
+
+
 @njit(cache=False)
 def _draw(lamps, px, py, pz, u):
     """sample_lamp for each (u1, u2) row: (N, 8) of direction, distance, radiance (red),
     pdf, and the pdf and radiance (red) intersect_lamp gives the ray from p along it."""
     out = np.zeros((u.shape[0], 8))
     for k in range(u.shape[0]):
-        wx, wy, wz, dist, lr, lg, lb, pdf = sample_lamp(lamps, 0, px, py, pz, u[k, 0], u[k, 1])
-        t, hr, hg, hb, hpdf = intersect_lamp(lamps, 0, px, py, pz, wx, wy, wz, 1e30, px, py, pz)
+        wx, wy, wz, dist, lr, lg, lb, pdf = sample_lamp(lamps, _NO_IES, 0, px, py, pz, u[k, 0], u[k, 1])
+        t, hr, hg, hb, hpdf = intersect_lamp(lamps, _NO_IES, 0, px, py, pz, wx, wy, wz, 1e30, px, py, pz)
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = wx, wy, wz, dist
         out[k, 4], out[k, 5], out[k, 6], out[k, 7] = lr, pdf, hpdf, hr
     return out

@@ -120,6 +120,25 @@ def test_point_lamp_in_a_mirror_closed_form():
         assert_mean(images[:, rows], float((direct + caustic)[rows].mean()))
 
 
+def test_an_ies_profile_weights_the_light_paths():
+    """The lamp with a profile of k for every direction below 90 degrees from its nadir (0
+    above 100): the floor's direct light (next-event estimation) and its caustic (light
+    paths, which leave the lamp downwards towards the mirror) are both k times the closed
+    form's; light paths that read the profile upside down would leave the caustic black."""
+    from mcengine.ies import IESProfile
+    v = np.arange(0, 181, 10)
+    k = 2.5
+    scene = mirror_scene()
+    scene.lights[0].ies = IESProfile(
+        h_angles=np.float32([0.0, 2.0 * math.pi]), v_angles=np.float32(np.radians(v)),
+        intensity=np.float32([np.where(v <= 90, k, 0.0)] * 2))
+    direct, caustic = mirror_closed_form()
+    images, _ = renders(scene, "light")
+    half = images.shape[1] // 2
+    for rows in (slice(0, half), slice(half, None)):
+        assert_mean(images[:, rows], k * float((direct + caustic)[rows].mean()))
+
+
 def test_path_tracing_leaves_the_point_lamps_caustic_black():
     direct, caustic = mirror_closed_form()
     images, _ = renders(mirror_scene(samples=16), "path")

@@ -49,7 +49,9 @@ def test_scenes_exist():
             # holdout objects and collections; true displacement
             "holdout_objects", "material_displacement",
             # random-walk subsurface scattering; objects' ray visibility; light linking
-            "material_subsurface", "ray_visibility", "light_linking"} <= names
+            "material_subsurface", "ray_visibility", "light_linking",
+            # IES light profiles
+            "light_ies"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

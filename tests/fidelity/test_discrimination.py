@@ -371,3 +371,17 @@ def test_ao_that_ignores_the_scene_is_caught(renders):
     result = renders.compare("material_bevel_ao", "AO of the floor alone", _ao_own_object_only)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _wall_washer_turned_back(scene):
+    """The WallWasher lamp turned -30 degrees about Z instead of +30: its profile as a renderer
+    that took directions into the lamp's frame by the matrix instead of its transpose would
+    shine."""
+    scene.objects["WallWasher"].rotation_euler[2] = -scene.objects["WallWasher"].rotation_euler[2]
+
+
+def test_a_turned_ies_profile_is_caught(renders):
+    """light_ies with the wall washer's brighter side turned 60 degrees: blocks differ."""
+    result = renders.compare("light_ies", "wall washer turned back", _wall_washer_turned_back)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

@@ -89,6 +89,7 @@ EFFECTS = {
 @dataclass(frozen=True)
 class EffectsPlan:
     lamp_types: dict = field(default_factory=dict)   # e.g. {"AREA": 2, "POINT": 1}
+    profiled: int = 0              # lamps with an IES profile (looked up per light sample)
     emissive_triangles: int = 0
     lobes: tuple = ()              # kinds of surface, in LOBE_ORDER
     textures: int = 0              # materials whose shaders evaluate nodes at every hit
@@ -130,6 +131,9 @@ class EffectsPlan:
     def summary(self) -> str:
         """One line: the lights and surfaces, then what is simulated and what is skipped."""
         lights = [f"{n} {t.lower()}" for t, n in sorted(self.lamp_types.items())]
+        if self.profiled:
+            n = self.profiled
+            lights = [", ".join(lights) + f" ({n} with {'IES profiles' if n > 1 else 'an IES profile'})"]
         if self.emissive_triangles:
             n = self.emissive_triangles
             lights.append(f"{n} emissive triangle{'s' if n > 1 else ''}")
@@ -216,6 +220,7 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         traced=traced,
         transparent_shadows=any(material_flags[i] & MF_TRANSPARENT for i in used),
         lamp_types=dict(Counter(li.type for li in lamps)),
+        profiled=sum(1 for li in lamps if li.ies is not None),
         emissive_triangles=int(emissive_triangles),
         world=bool(world_lit),
         world_shader=bool(world_lit and world_shader),

@@ -295,6 +295,14 @@ def test_a_disk_lamp_reads_the_profile_from_its_sampled_points():
     assert abs(m1 / value - m2) <= Z_LIMIT * math.hypot(se1 / value, se2)
 
 
+def test_the_effects_plan_names_the_profiled_lamps():
+    scene = plane_scene(_lamp_at(1.0, 1.2, radius=0.0))
+    scene.lights.append(Light(type="SPOT", matrix_world=translation(0, 0, H)))
+    from mcengine.session import RenderSession
+    line = RenderSession(scene, threads=1).plan.summary()
+    assert line.startswith("Lights: 1 point, 1 spot (1 with an IES profile); "), line
+
+
 def test_a_profile_survives_saving_the_scene(tmp_path):
     li = _lamp_at(1.0, 1.2, radius=0.0)
     scene = plane_scene(li)

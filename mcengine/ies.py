@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CANDELA_TO_WATTS", "FAILED_VALUE", "IESError", "IESProfile", "parse_ies"]
+__all__ = ["CANDELA_TO_WATTS", "FAILED_PROFILE", "FAILED_VALUE", "IESError", "IESProfile", "parse_ies"]
 
 CANDELA_TO_WATTS = 0.0706650768394     # 4 pi / 177.83
 FAILED_VALUE = 100.0                   # what Cycles' lookup gives for a profile it could not load
@@ -72,6 +72,12 @@ class IESProfile:
     @property
     def peak(self) -> float:
         return float(self.intensity.max()) if self.intensity.size else 0.0
+
+
+# What Cycles gives for a profile it could not load: 100 everywhere (the lookup's range is
+# [0, 2 pi) x [0, pi), and a constant table interpolates to its constant).
+FAILED_PROFILE = IESProfile(h_angles=np.float32([0.0, 2.0 * np.pi]), v_angles=np.float32([0.0, np.pi]),
+                            intensity=np.full((2, 2), FAILED_VALUE, np.float32))
 
 
 class _Reader:

@@ -27,15 +27,13 @@ irradiance needs no change.
 """
 from __future__ import annotations
 
-from pathlib import Path
-
-import bpy
 import numpy as np
 
-from mcengine.ies import FAILED_VALUE, IESError, parse_ies
+from mcengine.ies import FAILED_VALUE, IESError
 from mcengine.kernels.lights import LIGHT_SETS_ALL
 from mcengine.scene import Light
 
+from .ies import read_profile
 from .materials import linked_node, surface_graph
 
 __all__ = ["export_light"]
@@ -127,12 +125,13 @@ def _node_factor(ctx, data, name) -> tuple:
     shader = linked_node(out.inputs["Surface"]) if out is not None else None
     if shader is None:
         return np.zeros(3), None  # an empty light shader emits nothing in Cycles
-    constant = _constant_emission(ctx, out)
-    if constant is not None:
-        return constant, None
+    # An IES Texture first: folding the tree without its Factor would read its file again.
     profiled = _ies_emission(ctx, data, tree, out, name)
     if profiled is not None:
         return profiled
+    constant = _constant_emission(ctx, out)
+    if constant is not None:
+        return constant, None
     what = f"{shader.label or shader.name} shader"
     if shader.bl_idname == "ShaderNodeEmission":
         linked = [(linked_node(s), s.name) for s in (shader.inputs["Color"], shader.inputs["Strength"])
@@ -174,7 +173,7 @@ def _ies_emission(ctx, data, tree, out, name) -> tuple | None:
     strength = float(node.inputs["Strength"].default_value)
     key = node.as_pointer()
     try:
-        profile = parse_ies(_ies_text(node, data))
+        profile = read_profile(node, data.library)
     except (IESError, OSError) as exc:
         ctx.warn(f"light '{name}': IES Texture '{label}' could not be read ({exc}); rendered as "
                  f"Cycles renders it, {FAILED_VALUE:g} x Strength in every direction", "IES files")
@@ -193,16 +192,3 @@ def _ies_emission(ctx, data, tree, out, name) -> tuple | None:
                  "light nodes")
         return np.ones(3), None
     return at_one * strength, profile
-
-
-def _ies_text(node, data) -> bytes:
-    """The IES file's text as Cycles reads it: the Text's lines each ended by a newline
-    (mode Internal), or the file (External; '//' from the .blend's folder, or its library's)."""
-    if node.mode == "EXTERNAL":
-        path = bpy.path.abspath(node.filepath, library=data.library)
-        if not node.filepath:
-            raise IESError("no file given")
-        return Path(path).read_bytes()
-    if node.ies is None:
-        raise IESError("no text data-block given")
-    return "".join(line.body + "\n" for line in node.ies.lines).encode("utf-8")

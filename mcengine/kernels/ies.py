@@ -42,6 +42,13 @@ def _vertical(ies, base, wrap_vlow, wrap_vhigh, v, v_num, v_frac, h):
     return cubic_interp(a, b, c, d, v_frac)
 
 
+@device
+def _fraction(a, b, x):
+    """Where x lies between angles a and b (Cycles' inverse_lerp); 0 where a file repeats an
+    angle (b = a), which Cycles divides by."""
+    return (x - a) / (b - a) if b > a else 0.0
+
+
 @function
 def ies_lookup(ies, ofs, h_angle, v_angle):
     """The profile at ``ies[ofs:]`` at the angles (radians), as Cycles' kernel_ies_interp."""
@@ -62,8 +69,8 @@ def ies_lookup(ies, ofs, h_angle, v_angle):
     v_i = 0
     while ies[vs + v_i + 1] < v_angle:
         v_i += 1
-    h_frac = (h_angle - ies[hs + h_i]) / (ies[hs + h_i + 1] - ies[hs + h_i])
-    v_frac = (v_angle - ies[vs + v_i]) / (ies[vs + v_i + 1] - ies[vs + v_i])
+    h_frac = _fraction(ies[hs + h_i], ies[hs + h_i + 1], h_angle)
+    v_frac = _fraction(ies[vs + v_i], ies[vs + v_i + 1], v_angle)
     base = vs + v_num
     b = _vertical(ies, base, wrap_vlow, wrap_vhigh, v_i, v_num, v_frac, h_i)
     c = _vertical(ies, base, wrap_vlow, wrap_vhigh, v_i, v_num, v_frac, h_i + 1)

@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numba import njit
 
 from mcengine.ies import CANDELA_TO_WATTS, IESError, IESProfile, parse_ies
@@ -104,6 +106,47 @@ def test_type_a_and_b_are_brought_to_type_c():
 def test_files_cycles_cannot_read_are_errors(text, why):
     with pytest.raises(IESError, match=why):
         parse_ies(text)
+
+
+finite = dict(allow_nan=False, allow_infinity=False)
+angles = st.lists(st.floats(-400.0, 400.0, **finite), min_size=1, max_size=7)
+
+
+@settings(max_examples=300, deadline=None, derandomize=True, database=None)
+@given(v=angles, h=angles, kind=st.sampled_from([1, 2, 3]), data=st.data(),
+       cut=st.one_of(st.none(), st.integers(0, 400)))
+def test_any_file_is_read_or_refused_and_its_lookups_stay_finite(v, h, kind, data, cut):
+    """Files as careless exporters write them (angles unsorted, repeated, out of range,
+    negative candela, cut off anywhere): the reader gives a profile or an IESError, never
+    another exception, and the lookup of a profile is finite and not negative everywhere
+    (a repeated angle, where Cycles divides by zero, reads the lower one)."""
+    rows = [[data.draw(st.floats(-1e6, 1e6, **finite)) for _ in v] for _ in h]
+    text = ies_file(v, h, rows, kind=kind)
+    if cut is not None:
+        text = text[:cut]
+    try:
+        p = parse_ies(text)
+    except IESError:
+        return
+    assert p.intensity.shape == (len(p.h_angles), len(p.v_angles))
+    packed = p.packed()
+    rng = np.random.default_rng(0)
+    for a, b in zip(rng.uniform(-1.0, 7.5, 60), rng.uniform(-0.5, 3.7, 60)):
+        value = ies_lookup(packed, 0, a, b)
+        assert math.isfinite(value) and value >= 0.0
+    for a in p.h_angles[:3]:
+        for b in p.v_angles[:3]:
+            value = ies_lookup(packed, 0, float(a), float(b))
+            assert math.isfinite(value) and value >= 0.0
+
+
+@settings(max_examples=200, deadline=None, derandomize=True, database=None)
+@given(st.binary(max_size=300))
+def test_any_bytes_are_read_or_refused(blob):
+    try:
+        parse_ies(b"IESNA\nTILT=NONE\n" + blob)
+    except IESError:
+        pass
 
 
 # -- looking up -----------------------------------------------------------------------------------

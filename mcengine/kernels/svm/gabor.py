@@ -12,10 +12,9 @@ coordinates and the impulse's number (``hash``), so the pattern is Cycles' own.
 from __future__ import annotations
 
 import math
-import struct
 
 from ...jit import device, function
-from .hash import float_bits, hash_uint3, hash_uint4, unit
+from .hash import float_bits, hash_bits3, hash_bits4
 from .nodes import OFFSETS, OUTPUT_OFFSETS
 
 IMPULSES_COUNT = 8
@@ -31,8 +30,7 @@ _GB_VALUE, _GB_PHASE, _GB_INTENSITY = _GBO["Value"], _GBO["Phase"], _GBO["Intens
 
 # The float32 bit patterns of each impulse's seeds 3i, 3i + 1, 3i + 2 (the last key of its
 # orientation, centre and sign hashes).
-_SEED_BITS = tuple(tuple(struct.unpack("<I", struct.pack("<f", float(3 * i + j)))[0] for j in range(3))
-                   for i in range(IMPULSES_COUNT))
+_SEED_BITS = tuple(tuple(float_bits(float(3 * i + j)) for j in range(3)) for i in range(IMPULSES_COUNT))
 
 # sqrt(impulses x second moment 1/2 x the integral of the squared kernel: 1/4 in 2D,
 # 1/(4 sqrt 2) in 3D)
@@ -49,18 +47,6 @@ def _kernel(distance_squared, phase):
 
 
 @device
-def _h3(a, b, c):
-    """hash_float3_to_float of keys given as their float32 bit patterns."""
-    return unit(hash_uint3(a, b, c))
-
-
-@device
-def _h4(a, b, c, d):
-    """hash_float4_to_float of keys given as their float32 bit patterns."""
-    return unit(hash_uint4(a, b, c, d))
-
-
-@device
 def _cell_2d(cx, cy, px, py, frequency, isotropy, base_orientation):
     # The cell's keys as bit patterns once, not once per hash (float_bits is not free); the
     # kernel centre first, so that the impulses out of reach (most) skip the rest: the
@@ -70,13 +56,13 @@ def _cell_2d(cx, cy, px, py, frequency, isotropy, base_orientation):
     for i in range(IMPULSES_COUNT):
         k, k1, k2 = _SEED_BITS[i]
         # hash_float3_to_float2 of the kernel centre's seed (cx, cy, 3i + 1)
-        qx = px - _h3(bx, by, k1)
-        qy = py - _h3(k1, bx, by)
+        qx = px - hash_bits3(bx, by, k1)
+        qy = py - hash_bits3(k1, bx, by)
         d2 = qx * qx + qy * qy
         if d2 >= 1.0:
             continue
-        orientation = base_orientation + (_h3(bx, by, k) - 0.5) * math.pi * isotropy
-        weight = -1.0 if _h3(bx, by, k2) < 0.5 else 1.0
+        orientation = base_orientation + (hash_bits3(bx, by, k) - 0.5) * math.pi * isotropy
+        weight = -1.0 if hash_bits3(bx, by, k2) < 0.5 else 1.0
         fx, fy = frequency * math.cos(orientation), frequency * math.sin(orientation)
         a, b = _kernel(d2, 2.0 * math.pi * (qx * fx + qy * fy))
         re += weight * a
@@ -112,9 +98,9 @@ def _cell_3d(cx, cy, cz, px, py, pz, frequency, isotropy, ox, oy, oz, inclinatio
     for i in range(IMPULSES_COUNT):
         k, w, k2 = _SEED_BITS[i]
         # hash_float4_to_float3 of the kernel centre's seed (cx, cy, cz, 3i + 1)
-        qx = px - _h4(bx, by, bz, w)
-        qy = py - _h4(bz, bx, w, by)
-        qz = pz - _h4(w, bz, by, bx)
+        qx = px - hash_bits4(bx, by, bz, w)
+        qy = py - hash_bits4(bz, bx, w, by)
+        qz = pz - hash_bits4(w, bz, by, bx)
         d2 = qx * qx + qy * qy + qz * qz
         if d2 >= 1.0:
             continue
@@ -122,11 +108,11 @@ def _cell_3d(cx, cy, cz, px, py, pz, frequency, isotropy, ox, oy, oz, inclinatio
         if isotropy != 0.0:
             # the base turned by random angles in [0, pi] times the isotropy
             # (hash_float4_to_float2 of the seed (cx, cy, cz, 3i))
-            t = inclination + _h4(bx, by, bz, k) * math.pi * isotropy
-            f = azimuth + _h4(bz, bx, k, by) * math.pi * isotropy
+            t = inclination + hash_bits4(bx, by, bz, k) * math.pi * isotropy
+            f = azimuth + hash_bits4(bz, bx, k, by) * math.pi * isotropy
             s = math.sin(t)
             dx, dy, dz = s * math.cos(f), s * math.sin(f), math.cos(t)
-        weight = -1.0 if _h4(bx, by, bz, k2) < 0.5 else 1.0
+        weight = -1.0 if hash_bits4(bx, by, bz, k2) < 0.5 else 1.0
         a, b = _kernel(d2, 2.0 * math.pi * frequency * (qx * dx + qy * dy + qz * dz))
         re += weight * a
         im += weight * b

@@ -143,13 +143,25 @@ def hash_float2(x, y):
 
 
 @device
+def hash_bits3(a, b, c):
+    """hash_float3_to_float of keys given as their float32 bit patterns (``float_bits``)."""
+    return unit(hash_uint3(a, b, c))
+
+
+@device
+def hash_bits4(a, b, c, d):
+    """hash_float4_to_float of keys given as their float32 bit patterns (``float_bits``)."""
+    return unit(hash_uint4(a, b, c, d))
+
+
+@device
 def hash_float3(x, y, z):
-    return unit(hash_uint3(float_bits(x), float_bits(y), float_bits(z)))
+    return hash_bits3(float_bits(x), float_bits(y), float_bits(z))
 
 
 @device
 def hash_float4(x, y, z, w):
-    return unit(hash_uint4(float_bits(x), float_bits(y), float_bits(z), float_bits(w)))
+    return hash_bits4(float_bits(x), float_bits(y), float_bits(z), float_bits(w))
 
 
 # -- PCG (signed 32-bit arithmetic) -----------------------------------------------------------------

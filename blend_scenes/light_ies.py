@@ -13,6 +13,9 @@ Factor (a Math node scaling it).  The world is black: outside the beams only ind
   the file ``light_ies_downlight.ies`` next to this script, by a '//' path.
 * ``Panel``: a disk area light with a half profile (0-180, mirrored), its Factor times 2.5
   by a Math node before the Emission's Strength.
+* ``Sconce``: an emissive quad, tilted, whose material's Emission Strength is an IES Texture
+  with its Vector unlinked (Cycles' Incoming in the object's space: towards the receiver of
+  a light sample, towards the camera where it is seen), the wall washer's profile x 0.4.
 
 Run: .venv/bin/python blend_scenes/light_ies.py
 """
@@ -51,10 +54,11 @@ def panel(h, v):
     return 420.0 * (0.6 + 0.4 * math.cos(math.radians(h))) * max(0.0, math.cos(math.radians(v)))
 
 
-def profile_tree(light, mode, source, scale=None):
-    """IES Texture -> [Math multiply by scale ->] Emission Strength in the lamp's node tree."""
-    light.use_nodes = True
-    tree = light.node_tree
+def profile_tree(owner, mode, source, scale=None):
+    """IES Texture -> [Math multiply by scale ->] Emission Strength in the node tree of a lamp
+    or an emission material."""
+    owner.use_nodes = True
+    tree = owner.node_tree
     emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
     ies = tree.nodes.new("ShaderNodeTexIES")
     ies.location = (-500.0, 0.0)
@@ -94,6 +98,11 @@ def build(scene):
     area = c.add_light(scene, "Panel", "AREA", 1.2, (-2.0, 1.6, 2.4), target=(-1.2, 0.6, 0.0),
                        color=(0.7, 0.8, 1.0), shape="DISK", size=0.6)
     profile_tree(area.data, "INTERNAL", _half_profile(), scale=2.5)
+
+    sconce = c.emission_material("Sconce", (1.0, 0.9, 0.75), 1.0)
+    profile_tree(sconce, "INTERNAL", text, scale=0.4)
+    c.add_quad(scene, "Sconce", [(-0.2, -0.2, 0.0), (0.2, -0.2, 0.0), (0.2, 0.2, 0.0), (-0.2, 0.2, 0.0)],
+               sconce, location=(1.5, -1.3, 1.3), rotation=(math.radians(200.0), math.radians(15.0), 0.3))
 
 
 def _half_profile():

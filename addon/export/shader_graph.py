@@ -118,6 +118,23 @@ def _ao_props(node, ctx) -> dict:
 
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
 # ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
+def _ies_props(node, ctx) -> dict:
+    """IES Texture: its profile as the kernel reads it (``mcengine.ies``), and whether its
+    Vector is the implicit one (Cycles' Incoming in object space, taken as a normal).  A file
+    Cycles cannot read gives 100 in every direction, as in Cycles, warned."""
+    from mcengine.ies import FAILED_PROFILE, FAILED_VALUE, IESError
+
+    from .ies import read_profile
+    try:
+        profile = read_profile(node, getattr(node.id_data, "library", None))
+    except (IESError, OSError) as exc:
+        ctx.warn(f"IES Texture '{label(node)}' could not be read ({exc}); rendered as Cycles "
+                 f"renders it, {FAILED_VALUE:g} x Strength in every direction", "IES files")
+        profile = FAILED_PROFILE
+    return {"table": profile.packed().tolist(),
+            "implicit_vector": 1.0 if source(node.inputs["Vector"])[0] is None else 0.0}
+
+
 SPECIAL_PROPS = {
     "RGB": _output_value_props("color", 3),
     "Value": _output_value_props("value", 1),
@@ -130,6 +147,7 @@ SPECIAL_PROPS = {
     "VectorCurve": _curve_props(3, False),
     "FloatCurve": _curve_props(1, False),
     "AmbientOcclusion": _ao_props,
+    "TexIES": _ies_props,
 }
 
 

@@ -129,6 +129,39 @@ def test_ambient_occlusion_reads_the_worlds_distance_for_a_distance_of_0(scene, 
     assert warnings == []
 
 
+def test_an_ies_texture_carries_its_profile_and_whether_its_vector_is_implicit(scene, fake_session,
+                                                                              tmp_path):
+    """The IES Texture's table is its profile packed for the kernel; unlinked, its Vector is
+    the implicit one (Incoming in object space); a file Cycles cannot read gives Cycles' 100
+    everywhere, warned (not per material: the node's file is what is wrong)."""
+    import numpy as np
+
+    from mcengine.ies import FAILED_PROFILE, parse_ies
+    text = ("IESNA\nTILT=NONE\n1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n300 100\n")
+    block = bpy.data.texts.new("p.ies")
+    block.write(text)
+    mat = principled("Lamp shade")
+    tree = mat.node_tree
+    ies = tree.nodes.new("ShaderNodeTexIES")
+    ies.ies = block
+    tree.links.new(ies.outputs["Fac"], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    m, warnings = exported(fake_session, mat)
+    node = m.nodes[surface(m).inputs["Roughness"].node]
+    assert node.type == "TexIES" and node.props["implicit_vector"] == 1.0
+    np.testing.assert_array_equal(node.props["table"], parse_ies(text).packed())
+    assert warnings == []
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coords.outputs["Normal"], ies.inputs["Vector"])
+    ies.mode, ies.filepath = "EXTERNAL", str(tmp_path / "gone.ies")
+    m, _ = exported(fake_session, mat)
+    node = m.nodes[surface(m).inputs["Roughness"].node]
+    assert node.props["implicit_vector"] == 0.0
+    np.testing.assert_array_equal(node.props["table"], FAILED_PROFILE.packed())
+    assert any(w.startswith("IES Texture 'IES Texture' could not be read ([Errno 2]") and
+               w.endswith("rendered as Cycles renders it, 100 x Strength in every direction")
+               for w in export_scene(fake_session).warnings)
+
+
 def test_node_groups_are_flattened(scene, fake_session):
     group = bpy.data.node_groups.new("Tint", "ShaderNodeTree")
     group.interface.new_socket("In", in_out="INPUT", socket_type="NodeSocketColor")

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
+from ...ies import FAILED_PROFILE
 from ..closures.layout import SSS_BURLEY, SSS_RANDOM_WALK, SSS_RANDOM_WALK_SKIN
 
 FLOAT = "float"
@@ -249,14 +250,19 @@ GENERATED = "generated"
 UV = "uv"
 POSITION = "position"          # the point (world shaders: the ray direction)
 TANGENT = "tangent"            # the radial tangent about object Z (Geometry's Tangent)
+INCOMING = "incoming"          # towards the viewer (Geometry's Incoming)
 IMPLICIT = {GENERATED: ("TexCoord", "Generated"), UV: ("TexCoord", "UV"),
-            POSITION: ("NewGeometry", "Position"), TANGENT: ("NewGeometry", "Tangent")}
+            POSITION: ("NewGeometry", "Position"), TANGENT: ("NewGeometry", "Tangent"),
+            INCOMING: ("NewGeometry", "Incoming")}
 
 # Baked tables of the ColorRamp and curve nodes: Cycles samples them at RAMP_TABLE_SIZE + 1
 # evenly spaced positions (blender/util.h: colorramp_to_array, curvemapping_*_to_array).
 RAMP_TABLE_SIZE = 256
 _RAMP_X = [i / RAMP_TABLE_SIZE for i in range(RAMP_TABLE_SIZE + 1)]
 DEFAULT_RAMP = tuple(v for x in _RAMP_X for v in (x, x, x, 1.0))     # black to white, RGBA
+# An IES Texture without a profile: 100 in every direction, as Cycles gives it (packed as
+# kernels/ies.py reads profiles).
+DEFAULT_IES = tuple(FAILED_PROFILE.packed().tolist())
 IDENTITY_CURVE = tuple(_RAMP_X)
 IDENTITY_CURVES = tuple(v for x in _RAMP_X for v in (x, x, x))
 
@@ -499,6 +505,10 @@ VALUE_NODES = {
                                _v("Orientation 3D", (math.sqrt(2.0), math.sqrt(2.0), 0.0)),
                                _p("gabor_type", 2)),
                          (_f("Value", 0.0), _f("Phase", 0.0), _f("Intensity", 0.0)), True),
+    # IES Texture: "prop:implicit_vector" is 1 when nothing is linked to Vector (Cycles' default
+    # there is Incoming taken into object space as a normal); the table is the packed profile.
+    "TexIES": NodeSpec(410, (_v("Vector", INCOMING), _f("Strength", 1.0), _p("implicit_vector", 1),
+                             _table(DEFAULT_IES)), (_f("Fac", 0.0),), False),
     # Images (svm/image_nodes.py, codes 450-469).  "prop:image" is the image's slot in the
     # render's image table (the compiler finds the node's image by name; -1: missing, magenta);
     # "prop:alpha_linked" is 1 when the Alpha output is used (Cycles then divides the colour

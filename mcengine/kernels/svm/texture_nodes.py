@@ -3,7 +3,7 @@
 ``eval_texture_node`` evaluates one texture node: inputs at regs[b:] in the
 order of ``nodes.VALUE_NODES``, outputs to regs[c:].  The Vector input is
 always present: when nothing is linked to it, the compiler links the
-texture coordinate Cycles uses by default (Generated, or UV for images).
+texture coordinate Cycles uses by default (Generated, UV for images, Incoming for IES).
 Each texture's entry point is called, not inlined (compile time); Perlin
 noise and its fractals are in ``noise.py``, Voronoi in ``voronoi.py``, Gabor in
 ``gabor.py``, Cycles' hashes in ``hash.py``.
@@ -13,8 +13,10 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..ies import ies_direction
 from .gabor import gabor_node
 from .hash import hash_float, hash_float2, hash_float3, hash_float4, r32
+from .input_nodes import normal_to_object
 from .math_nodes import fmod
 from .nodes import NODES, OFFSETS, OUTPUT_OFFSETS
 from .noise import noise_fbm, noise_texture
@@ -59,6 +61,11 @@ _GR_VECTOR = OFFSETS["TexGradient"]["Vector"]
 _GR_TYPE = OFFSETS["TexGradient"]["prop:gradient_type"]
 
 _GABOR = NODES["TexGabor"].code
+
+_IES = NODES["TexIES"].code
+_IE = OFFSETS["TexIES"]
+_IE_VECTOR, _IE_STRENGTH, _IE_IMPLICIT, _IE_TABLE = (_IE["Vector"], _IE["Strength"],
+                                                     _IE["prop:implicit_vector"], _IE["prop:table"])
 
 _WAVE = NODES["TexWave"].code
 _WV = OFFSETS["TexWave"]
@@ -107,6 +114,19 @@ def eval_texture_node(code, regs, b, c, sd, tex):
         magic_node(regs, b, c)
     elif code == _GABOR:
         gabor_node(regs, b, c)
+    elif code == _IES:
+        ies_node(regs, b, c, sd, tex)
+
+
+@function
+def ies_node(regs, b, c, sd, tex):
+    """IES Texture (svm_node_ies): Strength times the profile (the node's table) along the
+    Vector, as given where linked; unlinked, the Incoming direction in the object's space, as a
+    normal (M^T d; the world and points of no object keep it in world space)."""
+    x, y, z = regs[b + _IE_VECTOR], regs[b + _IE_VECTOR + 1], regs[b + _IE_VECTOR + 2]
+    if regs[b + _IE_IMPLICIT] != 0.0 and sd.obj >= 0 and sd.prim >= 0:
+        x, y, z = normal_to_object(tex.objects[sd.obj], x, y, z)
+    regs[c] = regs[b + _IE_STRENGTH] * ies_direction(regs, b + _IE_TABLE + 1, x, y, z)
 
 
 @device

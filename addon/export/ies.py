@@ -8,6 +8,7 @@ makes the node give 100 x Strength in every direction (``mcengine.ies.FAILED_PRO
 """
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import bpy
@@ -28,4 +29,10 @@ def read_profile(node, library=None) -> IESProfile:
         raise IESError("no text data-block given")
     else:
         text = "".join(line.body + "\n" for line in node.ies.lines).encode("utf-8")
+    return _parsed(text)
+
+
+@functools.lru_cache(maxsize=16)
+def _parsed(text: bytes) -> IESProfile:
+    """One profile per text: instances of a lamp share it (and its block in the kernels')."""
     return parse_ies(text)

@@ -166,7 +166,7 @@ def _ies_emission(ctx, data, tree, out, name) -> tuple | None:
         return None
     node = nodes[0]
     label = node.label or node.name
-    if node.inputs["Vector"].is_linked or node.inputs["Strength"].is_linked:
+    if linked_node(node.inputs["Vector"]) is not None or linked_node(node.inputs["Strength"]) is not None:
         ctx.warn(f"light '{name}': IES Texture '{label}' with a linked Vector or Strength is not "
                  f"supported yet; rendered without its node tree (Emission strength 1)", "light nodes")
         return np.ones(3), None

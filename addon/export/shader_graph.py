@@ -26,9 +26,12 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from mcengine.ies import FAILED_PROFILE, FAILED_VALUE, IESError
 from mcengine.kernels.svm.nodes import NODES, RAMP_TABLE_SIZE, SHADER_ROUTING
 from mcengine.scene import Link, ShaderNode
 from mcengine.sky import SKY_TYPES
+
+from .ies import read_profile
 
 __all__ = ["GraphReader", "label", "node_type", "source", "SPECIAL_PROPS"]
 
@@ -116,15 +119,10 @@ def _ao_props(node, ctx) -> dict:
     return {"global_distance": float(world.light_settings.distance) if world is not None else 0.0}
 
 
-# Node type -> function(node, ctx) returning props read from data blocks (objects, images,
-# ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
 def _ies_props(node, ctx) -> dict:
     """IES Texture: its profile as the kernel reads it (``mcengine.ies``), and whether its
     Vector is the implicit one (Cycles' Incoming in object space, taken as a normal).  A file
     Cycles cannot read gives 100 in every direction, as in Cycles, warned."""
-    from mcengine.ies import FAILED_PROFILE, FAILED_VALUE, IESError
-
-    from .ies import read_profile
     try:
         profile = read_profile(node, getattr(node.id_data, "library", None))
     except (IESError, OSError) as exc:
@@ -135,6 +133,8 @@ def _ies_props(node, ctx) -> dict:
             "implicit_vector": 1.0 if source(node.inputs["Vector"])[0] is None else 0.0}
 
 
+# Node type -> function(node, ctx) returning props read from data blocks (objects, images,
+# ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
 SPECIAL_PROPS = {
     "RGB": _output_value_props("color", 3),
     "Value": _output_value_props("value", 1),

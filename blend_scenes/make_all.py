@@ -38,6 +38,7 @@ SCENES = (
     "motion_camera",
     "motion_deform",
     "material_principled",
+    "material_toon",
     "material_nodes",
     "material_suzanne",
     "material_rough_glass",

@@ -329,6 +329,8 @@ def surface_kinds(material) -> set:
             kinds.add("sharp refraction" if sharp("Roughness", 0.0) else "rough refraction")
         elif kind == "SubsurfaceScattering":
             kinds.add("subsurface")
+        elif kind == "BsdfToon":
+            kinds.add("rough glossy" if node.props.get("component") == "GLOSSY" else "diffuse")
         elif kind in ("BsdfTranslucent", "BsdfTransparent", "BsdfSheen", "Emission", "Holdout"):
             kinds.add({"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent",
                        "BsdfSheen": "sheen", "Emission": "emission", "Holdout": "holdout"}[kind])

@@ -50,8 +50,8 @@ def test_scenes_exist():
             "holdout_objects", "material_displacement",
             # random-walk subsurface scattering; objects' ray visibility; light linking
             "material_subsurface", "ray_visibility", "light_linking",
-            # IES light profiles
-            "light_ies"} <= names
+            # IES light profiles; the Toon BSDF
+            "light_ies", "material_toon"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

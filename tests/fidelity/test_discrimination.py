@@ -385,3 +385,17 @@ def test_a_turned_ies_profile_is_caught(renders):
     result = renders.compare("light_ies", "wall washer turned back", _wall_washer_turned_back)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _toon_block_diffuse(scene):
+    """The Block's glossy toon read as diffuse toon (a lobe about the normal instead of the
+    reflected view)."""
+    node = next(n for n in bpy.data.materials["BlockToon"].node_tree.nodes if n.type == "BSDF_TOON")
+    node.component = "DIFFUSE"
+
+
+def test_a_toon_lobe_about_the_wrong_axis_is_caught(renders):
+    """material_toon with the Block's highlight lobe about its normal: blocks differ."""
+    result = renders.compare("material_toon", "glossy toon as diffuse", _toon_block_diffuse)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

@@ -6,8 +6,9 @@ family computes a closure's ``eval`` (f·|cos θ_i| and pdf) and ``sample`` in
 its local frame: ``diffuse`` (Lambert, Oren–Nayar, translucent),
 ``microfacet`` (GGX and Beckmann reflection, refraction and glass, with the
 Fresnel models of ``fresnel`` and the energy-compensation ``tables``), ``sheen``,
-``ashikhmin`` (Ashikhmin-Shirley and the velvet) and ``bssrdf`` (subsurface scattering,
-which only picks the way in).  This module combines them as Cycles' surface_shader.h does:
+``ashikhmin`` (Ashikhmin-Shirley and the velvet), ``toon`` (the Toon BSDF's two lobes)
+and ``bssrdf`` (subsurface scattering, which only picks the way in).  This module combines
+them as Cycles' surface_shader.h does:
 
 * ``bsdf_eval``: F = Σ w_k·eval_k over the closures whose pdf is not zero
   (closures whose label a light excludes add nothing to F but keep their pdf),
@@ -58,6 +59,8 @@ from .layout import (
     CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
+    CT_DIFFUSE_TOON,
+    CT_GLOSSY_TOON,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
@@ -79,6 +82,7 @@ from .layout import (
 )
 from .microfacet import ggx_lambda_q, microfacet_eval, microfacet_sample
 from .sheen import sheen_eval, sheen_sample
+from .toon import diffuse_toon_eval, diffuse_toon_sample, glossy_toon_eval, glossy_toon_sample
 
 __all__ = ["bsdf_eval", "bsdf_sample", "bsdf_sample_closure", "closure_eval", "closure_sample", "LABEL_DIFFUSE",
            "LABEL_GLOSSY", "LABEL_NONE", "LABEL_REFLECT", "LABEL_SINGULAR", "LABEL_TRANSMIT",
@@ -99,16 +103,17 @@ def frame(cl, k):
 
 @device
 def is_diffuse(t):
-    """Whether closures of type t are diffuse-like (Cycles' CLOSURE_IS_BSDF_DIFFUSE: sheen and
-    translucent included)."""
-    return t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT
+    """Whether closures of type t are diffuse-like (Cycles' CLOSURE_IS_BSDF_DIFFUSE: sheen,
+    translucent and diffuse toon included)."""
+    return t == CT_DIFFUSE or t == CT_OREN_NAYAR or t == CT_SHEEN or t == CT_TRANSLUCENT \
+        or t == CT_DIFFUSE_TOON
 
 
 @device
 def is_glossy_reflection(t):
     """Whether closures of type t only reflect, glossily (microfacet reflection,
-    Ashikhmin-Shirley, and the velvet, which Cycles labels glossy)."""
-    return t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET
+    Ashikhmin-Shirley, glossy toon, and the velvet, which Cycles labels glossy)."""
+    return t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET or t == CT_GLOSSY_TOON
 
 
 @device
@@ -202,6 +207,10 @@ def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
         r, g, b, pdf = velvet_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_SHEEN:
         r, g, b, pdf = sheen_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_DIFFUSE_TOON:
+        r, g, b, pdf = diffuse_toon_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_GLOSSY_TOON:
+        r, g, b, pdf = glossy_toon_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
         r, g, b, pdf = microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
     else:
@@ -232,6 +241,10 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
         x, y, z, r, g, b, pdf, label = ashikhmin_shirley_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_VELVET:
         x, y, z, r, g, b, pdf, label = velvet_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_DIFFUSE_TOON:
+        x, y, z, r, g, b, pdf, label = diffuse_toon_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_GLOSSY_TOON:
+        x, y, z, r, g, b, pdf, label = glossy_toon_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_TRANSPARENT:
         return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
     elif t == CT_BSSRDF:

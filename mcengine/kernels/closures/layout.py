@@ -74,6 +74,8 @@ CT_TRANSPARENT = 8       # straight pass-through (a transparent bounce)
 CT_BSSRDF = 9            # subsurface scattering: a random walk inside the object (``subsurface``)
 CT_ASHIKHMIN_SHIRLEY = 10  # the Glossy BSDF's Ashikhmin-Shirley lobe (``ashikhmin``)
 CT_VELVET = 11           # the Sheen BSDF's Ashikhmin velvet (``ashikhmin``)
+CT_DIFFUSE_TOON = 12     # the Toon BSDF's diffuse component (``toon``)
+CT_GLOSSY_TOON = 13      # the Toon BSDF's glossy component (``toon``)
 
 # -- subsurface methods (the nodes' subsurface_method / falloff) -------------------------------
 SSS_BURLEY = 0           # Christensen-Burley: disk probes of the surface around the point

@@ -56,6 +56,8 @@ from ..closures.layout import (
     CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
     CT_DIFFUSE,
+    CT_DIFFUSE_TOON,
+    CT_GLOSSY_TOON,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
@@ -74,6 +76,7 @@ from ..closures.layout import (
 )
 from ..closures.sheen import sheen_setup
 from ..closures.thin_film import THIN_FILM_CUTOFF
+from ..closures.toon import toon_setup
 from ..sampling import orthonormal_basis
 from ..state import PF_DIFFUSE_ANCESTOR
 from .math_nodes import rotate_around_axis
@@ -110,6 +113,7 @@ from .nodes import (
     K_REFRACTION,
     K_SHEEN,
     K_SUBSURFACE,
+    K_TOON,
     K_TRANSLUCENT,
     K_TRANSPARENT,
     M_ANISOTROPY,
@@ -171,7 +175,12 @@ from .nodes import (
     SS_RADIUS,
     SS_ROUGHNESS,
     SS_SCALE,
+    T_COMPONENT,
+    T_NORMAL,
+    T_SIZE,
+    T_SMOOTH,
     TL_NORMAL,
+    TOON_GLOSSY,
 )
 
 
@@ -390,6 +399,15 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
                 cl[k, CL_VELVET_INV_SIGMA2] = 1.0 / max(sat(regs[b + S_ROUGHNESS]), 0.01) ** 2
             else:
                 sheen(cl, k, sd, nx, ny, nz, sat(regs[b + S_ROUGHNESS]))
+    elif kind == K_TOON:
+        glossy_lobe = regs[b + T_COMPONENT] == TOON_GLOSSY
+        if sd.reflective_caustics or not glossy_lobe:
+            k, n = alloc(cl, n, cr, cg, cb, sd)
+            if k >= 0:
+                nx, ny, nz = input_normal(regs, b + T_NORMAL, sd)
+                cl[k, CL_TYPE] = CT_GLOSSY_TOON if glossy_lobe else CT_DIFFUSE_TOON
+                set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
+                toon_setup(cl, k, regs[b + T_SIZE], regs[b + T_SMOOTH])
     elif kind == K_SUBSURFACE:
         scale = regs[b + SS_SCALE]
         nx, ny, nz = input_normal(regs, b + SS_NORMAL, sd)

@@ -57,6 +57,11 @@ DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_
                  "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY, "ASHIKHMIN": DIST_ASHIKHMIN,
                  "MICROFIBER": DIST_MICROFIBER}
 
+# The Toon BSDF's component.
+TOON_DIFFUSE = 0
+TOON_GLOSSY = 1
+TOON_COMPONENTS = {"DIFFUSE": TOON_DIFFUSE, "GLOSSY": TOON_GLOSSY}
+
 # Texture settings (codes are Cycles' enum values where it has them).
 DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
 NOISE_MULTIFRACTAL = 0
@@ -205,6 +210,7 @@ SSS_METHODS = {"BURLEY": SSS_BURLEY, "RANDOM_WALK": SSS_RANDOM_WALK,
 
 ENUMS = {
     "distribution": DISTRIBUTIONS,
+    "component": TOON_COMPONENTS,
     "subsurface_method": SSS_METHODS,
     "falloff": SSS_METHODS,
     "fresnel_type": FRESNEL_TYPES,
@@ -335,6 +341,8 @@ CLOSURES = {
                                           _v("Radius", (1.0, 0.2, 0.1)), _f("IOR", 1.4),
                                           _f("Roughness", 1.0), _f("Anisotropy", 0.0), _v("Normal"),
                                           _p("falloff", SSS_RANDOM_WALK)), _BSDF, False),
+    "BsdfToon": NodeSpec(14, (_c("Color", GREY), _f("Size", 0.5), _f("Smooth", 0.0), _v("Normal"),
+                              _p("component", TOON_DIFFUSE)), _BSDF, False),
     "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
                          (Socket("Emission", SHADER, None),), False),
     "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
@@ -675,6 +683,8 @@ SS_ROUGHNESS = _SS["Roughness"]
 SS_ANISOTROPY = _SS["Anisotropy"]
 SS_NORMAL = _SS["Normal"]
 SS_FALLOFF = _SS["prop:falloff"]
+_TN = OFFSETS["BsdfToon"]
+T_SIZE, T_SMOOTH, T_NORMAL, T_COMPONENT = _TN["Size"], _TN["Smooth"], _TN["Normal"], _TN["prop:component"]
 E_STRENGTH = OFFSETS["Emission"]["Strength"]
 assert OFFSETS["Background"]["Strength"] == E_STRENGTH
 
@@ -687,6 +697,7 @@ K_REFRACTION = KIND["BsdfRefraction"]
 K_TRANSLUCENT = KIND["BsdfTranslucent"]
 K_TRANSPARENT = KIND["BsdfTransparent"]
 K_SHEEN = KIND["BsdfSheen"]
+K_TOON = KIND["BsdfToon"]
 K_METALLIC = KIND["BsdfMetallic"]
 K_EMISSION = KIND["Emission"]
 K_HOLDOUT = KIND["Holdout"]

@@ -48,6 +48,8 @@ from mcengine.kernels.closures.layout import (
     CL_W,
     CT_ASHIKHMIN_SHIRLEY,
     CT_DIFFUSE,
+    CT_DIFFUSE_TOON,
+    CT_GLOSSY_TOON,
     CT_MICROFACET,
     CT_OREN_NAYAR,
     CT_TRANSLUCENT,
@@ -60,6 +62,13 @@ from mcengine.kernels.closures.microfacet import (
     microfacet_eval,
     microfacet_refraction_valid,
     microfacet_sample,
+)
+from mcengine.kernels.closures.toon import (
+    diffuse_toon_eval,
+    diffuse_toon_sample,
+    glossy_toon_eval,
+    glossy_toon_sample,
+    toon_setup,
 )
 
 
@@ -117,6 +126,12 @@ def velvet_row(roughness: float) -> np.ndarray:
     return cl
 
 
+def toon_row(ctype: int, size: float, smooth: float) -> np.ndarray:
+    cl = empty_row(ctype)
+    toon_setup(cl, 0, size, smooth)
+    return cl
+
+
 def direction(theta_deg: float, phi_deg: float = 0.0) -> tuple[float, float, float]:
     t = math.radians(theta_deg)
     p = math.radians(phi_deg)
@@ -138,6 +153,10 @@ def sample_batch(cl, wox, woy, woz, u, out):
             res = ashikhmin_shirley_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         elif t == CT_VELVET:
             res = velvet_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
+        elif t == CT_DIFFUSE_TOON:
+            res = diffuse_toon_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
+        elif t == CT_GLOSSY_TOON:
+            res = glossy_toon_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         else:
             res = microfacet_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         out[i, 0], out[i, 1], out[i, 2] = res[0], res[1], res[2]
@@ -160,6 +179,10 @@ def eval_batch(cl, wox, woy, woz, wi, out):
             res = ashikhmin_shirley_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         elif t == CT_VELVET:
             res = velvet_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
+        elif t == CT_DIFFUSE_TOON:
+            res = diffuse_toon_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
+        elif t == CT_GLOSSY_TOON:
+            res = glossy_toon_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         else:
             res = microfacet_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = res

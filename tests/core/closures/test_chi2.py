@@ -29,6 +29,8 @@ from scipy.special import erfc
 from mcengine.kernels.closures.layout import (
     CT_ASHIKHMIN_SHIRLEY,
     CT_DIFFUSE,
+    CT_DIFFUSE_TOON,
+    CT_GLOSSY_TOON,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
@@ -49,6 +51,7 @@ from .kernels import (
     direction,
     microfacet_row,
     oren_nayar_row,
+    toon_row,
     velvet_row,
 )
 
@@ -111,6 +114,11 @@ def _case_list():
         cases.append(("ashikhmin-shirley-aniso-r0.5", dict(ctype=CT_ASHIKHMIN_SHIRLEY, alpha=0.125,
                                                             alpha_y=0.5), theta, 60.0))
         cases.append(("velvet-r0.5", dict(ctype=CT_VELVET, sigma=0.5), theta, 0.0))
+    # the Toon BSDF: diffuse (size 0.5, smooth 0.2) and glossy (size 0.2, smooth 0.1, its cone
+    # about the reflected view cut by the horizon at grazing views)
+    for theta in THETAS:
+        cases.append(("toon-diffuse", dict(ctype=CT_DIFFUSE_TOON, size=0.5, smooth=0.2), theta, 0.0))
+        cases.append(("toon-glossy", dict(ctype=CT_GLOSSY_TOON, size=0.2, smooth=0.1), theta, 0.0))
     # GGX glass under a thin film (the Glass node's Thin Film Thickness 400, IOR 1.33)
     for eta in (1.5, 1.0 / 1.5):
         for theta in THETAS:
@@ -138,6 +146,8 @@ def _row(params: dict, wo) -> np.ndarray:
         return ashikhmin_shirley_row(p["alpha"], p.get("alpha_y"))
     if ctype == CT_VELVET:
         return velvet_row(p["sigma"])
+    if ctype in (CT_DIFFUSE_TOON, CT_GLOSSY_TOON):
+        return toon_row(ctype, p["size"], p["smooth"])
     return microfacet_row(ctype=ctype, **p)
 
 
@@ -161,7 +171,7 @@ def _params():
     out = []
     for i, (name, params, theta, phi) in enumerate(CASES):
         marks = () if (i in FAST or (name.endswith("r0.3") and theta == 45.0)
-                       or (name.startswith(("velvet", "ashikhmin")) and theta == 45.0)
+                       or (name.startswith(("velvet", "ashikhmin", "toon")) and theta == 45.0)
                        or ("r0.3-eta" in name and theta == 45.0)) else (pytest.mark.slow,)
         out.append(pytest.param(params, theta, phi, id=f"{name}-th{theta:g}-ph{phi:g}", marks=marks))
     return out

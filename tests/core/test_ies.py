@@ -8,6 +8,8 @@ passes through the table's values and reproduces a linear function away from the
 the frame (vertical angle 0 along the lamp's -Z, horizontal 0 along -Y, 90 along -X); the
 renders are a Lambert plane under a lamp whose profile is constant around the direction to
 the point seen, so that the irradiance is the profile's value times the lamp's without one.
+Property tests feed the reader careless files; the lamps' samples, hits and light paths are
+checked one by one against the same lamp without a profile times the profile along the light.
 """
 import math
 

@@ -427,7 +427,7 @@ class Light:
     visible_transmission: bool = True
     max_bounces: int = 1024
     light_sets: int = LIGHT_SETS_ALL  # light linking: the receivers' light sets it lights
-    ies: object = None               # mcengine.ies.IESProfile: its IES Texture's profile scales
+    ies: IESProfile | None = None    # its IES Texture's profile (mcengine.ies) scales
                                      # the strength along each direction (None: none)
     name: str = "Light"
 

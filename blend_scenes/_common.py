@@ -641,6 +641,17 @@ def add_stage(scene):
     return {"floor": floor, "cube": cube, "sphere": sphere, "block": block, "camera": camera}
 
 
+def add_material_lights(scene, fill=True):
+    """The lamps of the single-node material scenes: ``Key``, a warm square area lamp 1.2 m,
+    150 W, at (-2.0, -2.2, 3.2) aimed at the stage's objects, and (``fill``) ``Fill``, a bluish
+    point lamp 120 W, radius 0.2, at (2.5, -1.0, 2.0)."""
+    add_light(scene, "Key", "AREA", 150.0, (-2.0, -2.2, 3.2), target=(0.0, 0.0, 0.4),
+              color=(1.0, 0.9, 0.8), size=1.2)
+    if fill:
+        add_light(scene, "Fill", "POINT", 120.0, (2.5, -1.0, 2.0), color=(0.7, 0.8, 1.0),
+                  shadow_soft_size=0.2)
+
+
 def add_horizon_stage(scene):
     """The stage (:func:`add_stage`) seen from a camera lowered to z = 1.8, so that the world
     above the horizon fills the top of the frame (the world scenes)."""

@@ -39,6 +39,8 @@ SCENES = (
     "motion_deform",
     "material_principled",
     "material_toon",
+    "material_hair",
+    "material_ray_portal",
     "material_nodes",
     "material_suzanne",
     "material_rough_glass",

@@ -38,10 +38,7 @@ def build(scene):
         "CubeToon", _toon("DIFFUSE", (0.2, 0.4, 0.8), 0.7, 0.3), _toon("GLOSSY", (0.9, 0.9, 0.9), 0.15, 0.1))
     stage["block"].data.materials[0] = c.node_material(
         "BlockToon", "ShaderNodeBsdfToon", component="GLOSSY", color=(0.9, 0.75, 0.3), size=0.35, smooth=0.25)
-    c.add_light(scene, "Key", "AREA", 150.0, (-2.0, -2.2, 3.2), target=(0.0, 0.0, 0.4),
-                color=(1.0, 0.9, 0.8), size=1.2)
-    c.add_light(scene, "Fill", "POINT", 120.0, (2.5, -1.0, 2.0), color=(0.7, 0.8, 1.0),
-                shadow_soft_size=0.2)
+    c.add_material_lights(scene)
 
 
 if __name__ == "__main__":

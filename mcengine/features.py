@@ -278,10 +278,16 @@ def camera_effects(scene) -> tuple:
 
 LOBE_ORDER = ("diffuse", "rough diffuse", "subsurface", "sheen", "translucent", "rough glossy",
               "sharp glossy",
-              "coat", "rough glass", "sharp glass", "rough refraction", "sharp refraction",
-              "transparent", "emission", "holdout")
+              "coat", "hair", "rough glass", "sharp glass", "rough refraction", "sharp refraction",
+              "transparent", "ray portal", "emission", "holdout")
 # Roughness below which a microfacet lobe is a perfect mirror (alpha_x alpha_y <= 2e-10).
 SHARP_ROUGHNESS = 2e-10 ** 0.25
+
+
+# Nodes whose kind of surface does not depend on their inputs.
+_KINDS = {"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent", "BsdfSheen": "sheen",
+          "BsdfHair": "hair", "BsdfRayPortal": "ray portal", "Emission": "emission",
+          "Holdout": "holdout"}
 
 
 def surface_kinds(material) -> set:
@@ -331,9 +337,8 @@ def surface_kinds(material) -> set:
             kinds.add("subsurface")
         elif kind == "BsdfToon":
             kinds.add("rough glossy" if node.props.get("component") == "GLOSSY" else "diffuse")
-        elif kind in ("BsdfTranslucent", "BsdfTransparent", "BsdfSheen", "Emission", "Holdout"):
-            kinds.add({"BsdfTranslucent": "translucent", "BsdfTransparent": "transparent",
-                       "BsdfSheen": "sheen", "Emission": "emission", "Holdout": "holdout"}[kind])
+        elif kind in _KINDS:
+            kinds.add(_KINDS[kind])
         elif kind == "BsdfPrincipled":
             rough = "sharp" if sharp("Roughness", 0.5) else "rough"
             if below_one("Metallic", 0.0) and below_one("Transmission Weight", 0.0) \

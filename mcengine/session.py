@@ -337,6 +337,9 @@ class RenderSession:
             self.warnings.append(f"{self.integrator.name} does not trace Bevel and Ambient "
                                  f"Occlusion nodes: they give the shading normal and no "
                                  f"occlusion; Path Tracing traces them as Cycles")
+        if self._classic and "ray portal" in self.plan.lobes:
+            self.warnings.append(f"{self.integrator.name} does not follow Ray Portal BSDFs: "
+                                 f"their rays end there; Path Tracing follows them as Cycles")
         if self._classic and self.plan.light_linking:
             self.warnings.append(f"{self.integrator.name} does not honour light linking: every "
                                  f"light lights every object; Path Tracing honours it as Cycles")

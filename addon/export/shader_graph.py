@@ -133,6 +133,12 @@ def _ies_props(node, ctx) -> dict:
             "implicit_vector": 1.0 if source(node.inputs["Vector"])[0] is None else 0.0}
 
 
+def _hair_props(node, ctx) -> dict:
+    """Hair BSDF: whether its Tangent is the implicit one (on a mesh Cycles then takes the
+    triangle's dPdv and ignores the Offset)."""
+    return {"implicit_tangent": 1.0 if source(node.inputs["Tangent"])[0] is None else 0.0}
+
+
 # Node type -> function(node, ctx) returning props read from data blocks (objects, images,
 # ramps, curves) or sockets (RGB, Value, Normal), which the generic property copy cannot.
 SPECIAL_PROPS = {
@@ -148,6 +154,7 @@ SPECIAL_PROPS = {
     "FloatCurve": _curve_props(1, False),
     "AmbientOcclusion": _ao_props,
     "TexIES": _ies_props,
+    "BsdfHair": _hair_props,
 }
 
 
@@ -246,6 +253,9 @@ class GraphReader:
         kind = node_type(target)
         spec = NODES.get(kind)
         feature = f"{kind} node"
+        if kind == "LightPath" and out.identifier == "Portal Depth":
+            self.note(f"{label(target)} 'Portal Depth' into {label(node)}", "Light Path Portal Depth",
+                      "Portal Depth read as 0 (ray portals passed are not counted)")
         if kind == "TexSky" and target.sky_type not in SKY_TYPES:
             spec, feature = None, f"Sky Texture type {target.sky_type}"
         if spec is None or spec.outputs and spec.outputs[0].type == "shader":

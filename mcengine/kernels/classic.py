@@ -48,6 +48,7 @@ from .closures.layout import (
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_TRANSPARENT,
+    LABEL_RAY_PORTAL,
     LABEL_REFLECT,
     LABEL_SINGULAR,
     LABEL_TRANSMIT,
@@ -242,8 +243,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                 ckey = mix64(key ^ (np.uint64(c + 1) * _K_CHILD))
                 bu, bv, u_lobe, bw = sample_4d(SAMPLER_INDEPENDENT, ckey, SET_BSDF, _NO_MASK)
                 ds = sample_direction(cl, ncl, sp, dx, dy, dz, u_lobe, bu, bv, bw)
-                if not ds.ok:
-                    continue
+                if not ds.ok or ds.label & LABEL_RAY_PORTAL:
+                    continue      # (no ray portals here: warned by the session)
                 n_next = _push_child(nx, n_next, st, i, ckey, sp, ds.wix, ds.wiy, ds.wiz,
                                      br * ds.wr * k, bg * ds.wg * k, bb * ds.wb * k,
                                      next_path_flags(flags, ds.label), branching * ds.pdf, p)

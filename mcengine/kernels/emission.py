@@ -44,7 +44,7 @@ from .lights import (
     lamp_profile,
     spot_attenuation,
 )
-from .sampling import cosine_hemisphere, disk_concentric, orthonormal_basis, uniform_cone
+from .sampling import around, cosine_hemisphere, disk_concentric, uniform_cone
 
 Emission = namedtuple("Emission", [
     "ok",                  # False: nothing emitted
@@ -102,13 +102,6 @@ def _none():
 
 
 @device
-def _around(ax, ay, az, x, y, z):
-    """(x, y, z) in a frame whose third axis is a."""
-    tx, ty, tz, bx, by, bz = orthonormal_basis(ax, ay, az)
-    return (x * tx + y * bx + z * ax, x * ty + y * by + z * ay, x * tz + y * bz + z * az)
-
-
-@device
 def sample_emission(lamps, ies, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u4):
     """A lamp picked by power, a point on it and a direction (an :class:`Emission`), its
     power weighted by the lamp's IES profile along the direction."""
@@ -134,7 +127,7 @@ def sample_emission(lamps, ies, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u
         x, y, z = cosine_hemisphere(u3, u4)
         if not z > 0.0:
             return _none()
-        dx, dy, dz = _around(-lamps[idx, L_AZ], -lamps[idx, L_AZ + 1], -lamps[idx, L_AZ + 2], x, y, z)
+        dx, dy, dz = around(-lamps[idx, L_AZ], -lamps[idx, L_AZ + 1], -lamps[idx, L_AZ + 2], x, y, z)
         k = area_spread(lamps, idx, z) * math.pi * area / pmf   # L cos / (pmf / A * cos / pi)
         k *= lamp_profile(lamps, ies, idx, dx, dy, dz)
         return Emission(True, idx, px, py, pz, dx, dy, dz, lamps[idx, L_RADIANCE] * k,
@@ -143,7 +136,7 @@ def sample_emission(lamps, ies, emit_cdf, emit_pmf, cones, u_pick, u1, u2, u3, u
     omc = cones[idx]
     x, y, z = uniform_cone(u3, u4, omc)
     if omc < 2.0:
-        dx, dy, dz = _around(-lamps[idx, L_AZ], -lamps[idx, L_AZ + 1], -lamps[idx, L_AZ + 2], x, y, z)
+        dx, dy, dz = around(-lamps[idx, L_AZ], -lamps[idx, L_AZ + 1], -lamps[idx, L_AZ + 2], x, y, z)
     else:
         dx, dy, dz = x, y, z
     att = spot_attenuation(lamps, idx, dx, dy, dz) if int(lamps[idx, L_TYPE]) == LT_SPOT else 1.0

@@ -43,10 +43,11 @@ import numpy as np
 
 from ..jit import device, kernel
 from .camera import C_APERTURE, C_MOTION_STEPS, C_VIEW_POST, C_VIEW_PRE
-from .closures import bsdf_eval, bsdf_sample_closure
+from .closures import bsdf_eval, bsdf_sample_closure, free_side
 from .closures.layout import (
     CL_ETA,
     CL_N,
+    CL_TYPE,
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
     LABEL_REFLECT,
@@ -130,6 +131,9 @@ def prepare(scene, sc, cfg, plan) -> tuple:
     if it.filter_glossy > 0:
         off.append("Path + Light Tracing renders as path tracing with Filter Glossy (blurred "
                    "lobes are no longer singular, so the two would count some paths twice)")
+    if "ray portal" in plan.lobes:
+        off.append("Path + Light Tracing renders as path tracing with Ray Portal BSDFs (light "
+                   "paths do not go through portals)")
     lamps = sc.lamps
     if off or not plan.caustics or not len(lamps):
         return None, off
@@ -315,7 +319,8 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
         wox, woy, woz, wr, wg, wb, pdf, label, kpick = bsdf_sample_closure(
             scratch.cl, res.n, wix, wiy, wiz, rand(key, d + 2), rand(key, d), rand(key, d + 1),
             rand(key, d + 3))
-        if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not leaves_correct_side(sp, wox, woy, woz, label):
+        if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not (
+                free_side(scratch.cl[kpick, CL_TYPE]) or leaves_correct_side(sp, wox, woy, woz, label)):
             continue
         flags = st.flags[i]
         if label & LABEL_TRANSPARENT:

@@ -46,7 +46,7 @@ import numpy as np
 
 from ..jit import device
 from .ies import ies_direction
-from .sampling import disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf
+from .sampling import around, disk_concentric, orthonormal_basis, uniform_cone, uniform_cone_pdf
 
 LT_POINT = 0
 LT_SPOT = 1
@@ -540,10 +540,7 @@ def _sample_lamp(lamps, li, px, py, pz, u1, u2):
             return (azx, azy, azz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1],
                     lamps[li, L_RADIANCE + 2], 0.0)
         x, y, z = uniform_cone(u1, u2, omc)
-        tx, ty, tz, bx, by, bz = orthonormal_basis(azx, azy, azz)
-        wx = x * tx + y * bx + z * azx
-        wy = x * ty + y * by + z * azy
-        wz = x * tz + y * bz + z * azz
+        wx, wy, wz = around(azx, azy, azz, x, y, z)
         return (wx, wy, wz, math.inf, lamps[li, L_RADIANCE], lamps[li, L_RADIANCE + 1], lamps[li, L_RADIANCE + 2],
                 uniform_cone_pdf(omc))
 
@@ -624,10 +621,7 @@ def _sample_lamp(lamps, li, px, py, pz, u1, u2):
     else:
         # Sphere: uniform over the cone of directions it subtends.
         x, y, z = uniform_cone(u1, u2, omc)
-        tx, ty, tz, bx, by, bz = orthonormal_basis(nx, ny, nz)
-        wx = x * tx + y * bx + z * nx
-        wy = x * ty + y * by + z * ny
-        wz = x * tz + y * bz + z * nz
+        wx, wy, wz = around(nx, ny, nz, x, y, z)
         # Distance to the near side of the sphere along wi.
         b_ = d * z
         disc = r * r - (d2 - b_ * b_)

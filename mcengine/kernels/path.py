@@ -40,6 +40,7 @@ from .closures.layout import (
     CL_ENERGY,
     CL_N,
     CL_NS,
+    CL_PORTAL_P,
     CL_RADIUS,
     CL_SSS_ALBEDO,
     CL_SSS_METHOD,
@@ -56,6 +57,7 @@ from .closures.layout import (
     CT_MICROFACET_REFRACTION,
     CT_TRANSPARENT,
     LABEL_DIFFUSE,
+    LABEL_RAY_PORTAL,
     LABEL_REFLECT,
     LABEL_SINGULAR,
     LABEL_SUBSURFACE,
@@ -403,6 +405,30 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             if _walk(sc, st, i, scratch.cl, ds.pick, p, sp, ds.wix, ds.wiy, ds.wiz, vertex,
                      sampler, mask):
                 st.alive[i] = 1
+            continue
+        if ds.label & LABEL_RAY_PORTAL:
+            # On from the portal's point (Cycles' integrate_surface_ray_portal): a transparent
+            # bounce that keeps the path's flags; light the new ray finds is not weighted by
+            # MIS (no light sample can pass a portal), its length counts from that point.
+            st.transparent[i] += 1
+            flags |= PF_TRANSPARENT | PF_MIS_SKIP
+            if st.transparent[i] >= max_transparent:
+                flags |= PF_TERMINATE
+            st.flags[i] = flags
+            k = ds.pick
+            qx, qy, qz = scratch.cl[k, CL_PORTAL_P], scratch.cl[k, CL_PORTAL_P + 1], scratch.cl[k, CL_PORTAL_P + 2]
+            ex, ey, ez = qx - sp.hx, qy - sp.hy, qz - sp.hz
+            if ex * ex + ey * ey + ez * ez > 1e-9:
+                st.self_prim[i] = -1           # elsewhere: it may meet this triangle again
+            else:
+                qx, qy, qz = offset_origin(sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz,
+                                           ds.wix, ds.wiy, ds.wiz)
+                st.self_prim[i] = p
+            st.mis_p[i, 0], st.mis_p[i, 1], st.mis_p[i, 2] = qx, qy, qz
+            st.dp[i] = footprint
+            set_ray(st.ray_o, st.ray_d, st.ray_tmax, st.o32, st.d32, st.t32, i,
+                    qx, qy, qz, ds.wix, ds.wiy, ds.wiz, math.inf)
+            st.alive[i] = 1
             continue
         if ds.label & LABEL_TRANSPARENT:
             # Straight through: a transparent bounce, the path keeps its flags and MIS data.

@@ -286,6 +286,14 @@ def orthonormal_basis(nx, ny, nz):
 
 
 @device
+def around(ax, ay, az, x, y, z):
+    """(x, y, z) given in a frame whose third axis is the unit vector a
+    (``orthonormal_basis``), in world coordinates."""
+    tx, ty, tz, bx, by, bz = orthonormal_basis(ax, ay, az)
+    return x * tx + y * bx + z * ax, x * ty + y * by + z * ay, x * tz + y * bz + z * az
+
+
+@device
 def make_orthonormals(nx, ny, nz):
     """Cycles' make_orthonormals: a = normalize((1, 1, 1) x n) (or (-1, 1, 1) x n when the
     components are equal), b = n x a.  Where Cycles builds a frame this way and the result

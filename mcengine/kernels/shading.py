@@ -43,6 +43,7 @@ from .closures import (
     LABEL_TRANSMIT,
     bsdf_eval,
     bsdf_sample_closure,
+    free_side,
 )
 from .closures.layout import CL_SW, CL_TERMINATOR, CL_TYPE, CL_W, CT_BSSRDF, CT_DIFFUSE
 from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
@@ -513,6 +514,7 @@ def sample_direction(cl, ncl, sp, dx, dy, dz, u_pick, u1, u2, u3):
     """The closures sample the next direction at ``sp`` for a ray of direction d."""
     wix, wiy, wiz, wr, wg, wb, pdf, label, pick = bsdf_sample_closure(cl, ncl, -dx, -dy, -dz,
                                                                       u_pick, u1, u2, u3)
-    if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not leaves_correct_side(sp, wix, wiy, wiz, label):
+    if (wr == 0.0 and wg == 0.0 and wb == 0.0) or not (
+            free_side(cl[pick, CL_TYPE]) or leaves_correct_side(sp, wix, wiy, wiz, label)):
         return DirectionSample(False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, label, pick)
     return DirectionSample(True, wix, wiy, wiz, wr, wg, wb, pdf, label, pick)

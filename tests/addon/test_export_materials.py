@@ -239,11 +239,11 @@ def test_every_bsdf_node_is_copied(scene, fake_session, bl_idname, kind):
 
 def test_unsupported_shaders_fall_back_to_grey_diffuse(scene, fake_session):
     mat = bpy.data.materials.new("Strands")
-    replace_surface(mat, "ShaderNodeBsdfHair")
+    replace_surface(mat, "ShaderNodeBsdfHairPrincipled")
     m, warnings = exported(fake_session, mat)
     assert surface(m).type == "BsdfDiffuse" and surface(m).inputs["Color"] == (0.8, 0.8, 0.8)
-    assert warnings == ["material 'Strands': Hair BSDF surface shader not supported yet; "
-                        "Hair BSDF rendered as 0.8 grey diffuse"]
+    assert warnings == ["material 'Strands': Principled Hair BSDF surface shader not supported "
+                        "yet; Principled Hair BSDF rendered as 0.8 grey diffuse"]
 
 
 @pytest.mark.parametrize("fresnel", ["F82", "PHYSICAL_CONDUCTOR"])

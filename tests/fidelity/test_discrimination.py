@@ -399,3 +399,38 @@ def test_a_toon_lobe_about_the_wrong_axis_is_caught(renders):
     result = renders.compare("material_toon", "glossy toon as diffuse", _toon_block_diffuse)
     assert result.verdict == "differ"
     assert result.agreement.differing_blocks()
+
+
+def _hair_sphere_along_latitudes(scene):
+    """The Sphere's strands along its latitudes (a Tangent node, radial about Z) instead of
+    its triangles' dPdv: what a renderer that took another edge or dPdu would shine."""
+    tree = bpy.data.materials["SphereHair"].node_tree
+    hair = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfHair")
+    tangent = tree.nodes.new("ShaderNodeTangent")
+    tangent.direction_type, tangent.axis = "RADIAL", "Z"
+    tree.links.new(tangent.outputs["Tangent"], hair.inputs["Tangent"])
+
+
+def test_a_hair_strand_along_the_wrong_edge_is_caught(renders):
+    """material_hair with the sphere's highlights turned along its latitudes: blocks differ."""
+    result = renders.compare("material_hair", "sphere strands along latitudes",
+                             _hair_sphere_along_latitudes)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()
+
+
+def _window_not_moved(scene):
+    """The Window's portal with nothing linked to its Position: what a renderer that sent the
+    ray on from the shading point, ignoring the Position, would give."""
+    tree = bpy.data.materials["Window"].node_tree
+    portal = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfRayPortal")
+    for link in list(portal.inputs["Position"].links):
+        tree.links.remove(link)
+
+
+def test_a_portal_that_ignores_its_position_is_caught(renders):
+    """material_ray_portal with the window showing what lies behind it instead of the view
+    from 1.5 m higher: blocks differ."""
+    result = renders.compare("material_ray_portal", "window not moved", _window_not_moved)
+    assert result.verdict == "differ"
+    assert result.agreement.differing_blocks()

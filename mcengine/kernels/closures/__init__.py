@@ -6,8 +6,9 @@ family computes a closure's ``eval`` (f·|cos θ_i| and pdf) and ``sample`` in
 its local frame: ``diffuse`` (Lambert, Oren–Nayar, translucent),
 ``microfacet`` (GGX and Beckmann reflection, refraction and glass, with the
 Fresnel models of ``fresnel`` and the energy-compensation ``tables``), ``sheen``,
-``ashikhmin`` (Ashikhmin-Shirley and the velvet), ``toon`` (the Toon BSDF's two lobes)
-and ``bssrdf`` (subsurface scattering, which only picks the way in).  This module combines
+``ashikhmin`` (Ashikhmin-Shirley and the velvet), ``toon`` (the Toon BSDF's two lobes),
+``hair`` (the Hair BSDF's two) and ``bssrdf`` (subsurface scattering, which only picks the
+way in).  This module combines
 them as Cycles' surface_shader.h does:
 
 * ``bsdf_eval``: F = Σ w_k·eval_k over the closures whose pdf is not zero
@@ -19,7 +20,9 @@ them as Cycles' surface_shader.h does:
   lobe: w_k·(eval / pdf)·Σ sw / sw_k), the mixture pdf (0 for singular lobes),
   the lobe's label and k.  A BSSRDF (``bssrdf``) has no value: it only counts in Σ sw, and
   when picked gives the direction into the object with weight w_k·Σ sw / sw_k and the
-  label LABEL_SUBSURFACE (the path tracer then walks inside).
+  label LABEL_SUBSURFACE (the path tracer then walks inside).  A Ray Portal has no value
+  either: when picked it gives its direction with weight w_k·Σ sw / sw_k and the label
+  LABEL_RAY_PORTAL (the path tracer then moves the ray to the portal's point).
 
 Every closure whose normal differs from the point's smooth normal (a normal map,
 Bump Map Correction's lift of a glossy normal) carries Cycles' bump shadowing
@@ -46,10 +49,12 @@ from .diffuse import (
     translucent_eval,
     translucent_sample,
 )
+from .hair import hair_eval, hair_sample
 from .layout import (
     CL_BUMP_CORRECTION,
     CL_N,
     CL_NS,
+    CL_PORTAL_D,
     CL_SSS_METHOD,
     CL_SW,
     CL_T,
@@ -61,11 +66,14 @@ from .layout import (
     CT_DIFFUSE,
     CT_DIFFUSE_TOON,
     CT_GLOSSY_TOON,
+    CT_HAIR_REFLECTION,
+    CT_HAIR_TRANSMISSION,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_NONE,
     CT_OREN_NAYAR,
+    CT_RAY_PORTAL,
     CT_SHEEN,
     CT_TRANSLUCENT,
     CT_TRANSPARENT,
@@ -73,6 +81,7 @@ from .layout import (
     LABEL_DIFFUSE,
     LABEL_GLOSSY,
     LABEL_NONE,
+    LABEL_RAY_PORTAL,
     LABEL_REFLECT,
     LABEL_SINGULAR,
     LABEL_SUBSURFACE,
@@ -112,15 +121,27 @@ def is_diffuse(t):
 @device
 def is_glossy_reflection(t):
     """Whether closures of type t only reflect, glossily (microfacet reflection,
-    Ashikhmin-Shirley, glossy toon, and the velvet, which Cycles labels glossy)."""
-    return t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET or t == CT_GLOSSY_TOON
+    Ashikhmin-Shirley, glossy toon, hair reflection, and the velvet, which Cycles labels
+    glossy)."""
+    return t == CT_MICROFACET or t == CT_ASHIKHMIN_SHIRLEY or t == CT_VELVET or t == CT_GLOSSY_TOON \
+        or t == CT_HAIR_REFLECTION
 
 
 @device
 def has_transmission(t):
     """Whether closures of type t send light through the surface (Cycles'
-    SD_BSDF_HAS_TRANSMISSION: translucent, microfacet refraction and glass)."""
-    return t == CT_TRANSLUCENT or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS
+    SD_BSDF_HAS_TRANSMISSION: translucent, microfacet refraction and glass, hair
+    transmission)."""
+    return t == CT_TRANSLUCENT or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS \
+        or t == CT_HAIR_TRANSMISSION
+
+
+@device
+def free_side(t):
+    """Whether directions sampled from closures of type t may leave to either side of the
+    geometric surface (Cycles checks no side for hair and portals; the others' samples
+    must leave to the side their label says: ``shading.leaves_correct_side``)."""
+    return t == CT_HAIR_REFLECTION or t == CT_HAIR_TRANSMISSION or t == CT_RAY_PORTAL
 
 
 @device
@@ -211,6 +232,8 @@ def closure_eval(cl, k, wox, woy, woz, wix, wiy, wiz):
         r, g, b, pdf = diffuse_toon_eval(cl, k, lox, loy, loz, lix, liy, liz)
     elif t == CT_GLOSSY_TOON:
         r, g, b, pdf = glossy_toon_eval(cl, k, lox, loy, loz, lix, liy, liz)
+    elif t == CT_HAIR_REFLECTION or t == CT_HAIR_TRANSMISSION:
+        r, g, b, pdf = hair_eval(cl, k, t == CT_HAIR_TRANSMISSION, lox, loy, loz, lix, liy, liz)
     elif t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS:
         r, g, b, pdf = microfacet_eval(cl, k, lox, loy, loz, lix, liy, liz)
     else:
@@ -245,8 +268,14 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
         x, y, z, r, g, b, pdf, label = diffuse_toon_sample(cl, k, lox, loy, loz, u1, u2, u3)
     elif t == CT_GLOSSY_TOON:
         x, y, z, r, g, b, pdf, label = glossy_toon_sample(cl, k, lox, loy, loz, u1, u2, u3)
+    elif t == CT_HAIR_REFLECTION or t == CT_HAIR_TRANSMISSION:
+        x, y, z, r, g, b, pdf, label = hair_sample(cl, k, t == CT_HAIR_TRANSMISSION, lox, loy, loz,
+                                                   u1, u2)
     elif t == CT_TRANSPARENT:
         return -wox, -woy, -woz, 1.0, 1.0, 1.0, 0.0, LABEL_TRANSMIT | LABEL_TRANSPARENT
+    elif t == CT_RAY_PORTAL:
+        return (cl[k, CL_PORTAL_D], cl[k, CL_PORTAL_D + 1], cl[k, CL_PORTAL_D + 2], 1.0, 1.0, 1.0,
+                0.0, LABEL_TRANSMIT | LABEL_RAY_PORTAL)
     elif t == CT_BSSRDF:
         x, y, z, ok = bssrdf_entry(cl, k, lox, loy, loz, u1, u2)
         if not ok:
@@ -277,7 +306,7 @@ def excluded(t, exclude):
         return (exclude & LABEL_DIFFUSE) != 0
     if is_glossy_reflection(t):
         return (exclude & LABEL_GLOSSY) != 0
-    if t == CT_MICROFACET_REFRACTION:
+    if t == CT_MICROFACET_REFRACTION or t == CT_HAIR_TRANSMISSION:
         return (exclude & LABEL_TRANSMIT) != 0
     if t == CT_MICROFACET_GLASS:
         return (exclude & LABEL_GLOSSY) != 0 and (exclude & LABEL_TRANSMIT) != 0
@@ -295,7 +324,7 @@ def _eval_sum(cl, n, skip, wox, woy, woz, wix, wiy, wiz, exclude, fr, fg, fb, su
             continue
         sw = cl[k, CL_SW]
         sum_sw += sw
-        if t == CT_TRANSPARENT:
+        if t == CT_TRANSPARENT or t == CT_RAY_PORTAL:
             continue
         if t == CT_DIFFUSE or t == CT_TRANSLUCENT:
             r, g, b, pdf = diffuse_closure_eval(cl, k, t, wix, wiy, wiz)
@@ -352,7 +381,7 @@ def bsdf_sample_closure(cl, n, wox, woy, woz, u_pick, u1, u2, u3):
     wix, wiy, wiz, r, g, b, pdf, label = closure_sample(cl, pick, wox, woy, woz, u1, u2, u3)
     if label == LABEL_NONE:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, LABEL_NONE, pick
-    if label & (LABEL_SINGULAR | LABEL_TRANSPARENT | LABEL_SUBSURFACE):
+    if label & (LABEL_SINGULAR | LABEL_TRANSPARENT | LABEL_SUBSURFACE | LABEL_RAY_PORTAL):
         # A BSSRDF's weight: Cycles' surface_shader_bssrdf_sample_weight.
         k = total / sw
         return (wix, wiy, wiz, cl[pick, CL_W] * r * k, cl[pick, CL_W + 1] * g * k,

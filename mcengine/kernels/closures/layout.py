@@ -60,6 +60,15 @@ CL_SSS_ALBEDO = CL_F0    # 3: the surface albedo the walk reproduces
 CL_ANISOTROPY = CL_P3    # the phase function's g, in [0, 0.9]
 CL_SSS_METHOD = CL_P4    # SSS_* method
 CL_VELVET_INV_SIGMA2 = CL_P0   # a velvet's 1 / sigma^2 (sigma = max(roughness, 0.01))
+# A Hair BSDF row: the strand's tangent in the closure's local frame (not orthogonal to the
+# normal when a Tangent is linked), the roughnesses along and around it, and its offset angle.
+CL_HAIR_T = CL_F0        # 3
+CL_HAIR_R1 = CL_P0
+CL_HAIR_R2 = CL_P1
+CL_HAIR_OFFSET = CL_P2
+# A Ray Portal row: where the ray continues and in which unit direction (world space).
+CL_PORTAL_P = CL_F0      # 3
+CL_PORTAL_D = CL_F90     # 3
 
 # -- closure types -------------------------------------------------------------------------------
 CT_NONE = 0
@@ -76,6 +85,9 @@ CT_ASHIKHMIN_SHIRLEY = 10  # the Glossy BSDF's Ashikhmin-Shirley lobe (``ashikhm
 CT_VELVET = 11           # the Sheen BSDF's Ashikhmin velvet (``ashikhmin``)
 CT_DIFFUSE_TOON = 12     # the Toon BSDF's diffuse component (``toon``)
 CT_GLOSSY_TOON = 13      # the Toon BSDF's glossy component (``toon``)
+CT_HAIR_REFLECTION = 14  # the Hair BSDF's reflection component (``hair``)
+CT_HAIR_TRANSMISSION = 15  # the Hair BSDF's transmission component (``hair``)
+CT_RAY_PORTAL = 16       # the Ray Portal BSDF: the ray goes on from another point (a transparent bounce)
 
 # -- subsurface methods (the nodes' subsurface_method / falloff) -------------------------------
 SSS_BURLEY = 0           # Christensen-Burley: disk probes of the surface around the point
@@ -102,6 +114,7 @@ LABEL_GLOSSY = 8
 LABEL_SINGULAR = 16
 LABEL_TRANSPARENT = 32
 LABEL_SUBSURFACE = 256   # into the object, for a random walk (Cycles' LABEL_SUBSURFACE_SCATTER)
+LABEL_RAY_PORTAL = 512   # on from the Ray Portal's point and direction
 
 # alpha_x * alpha_y at or below this is a singular (perfectly smooth) lobe: it can only be
 # sampled, never evaluated (Cycles' BSDF_ROUGHNESS_SQ_THRESH; roughness about 0.0038).

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device
-from ..sampling import orthonormal_basis, uniform_cone, uniform_cone_pdf
+from ..sampling import around, uniform_cone, uniform_cone_pdf
 from .layout import CL_P0, CL_P1, LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_NONE, LABEL_REFLECT
 
 _HALF_PI = 0.5 * math.pi
@@ -98,10 +98,7 @@ def glossy_toon_sample(cl, k, wox, woy, woz, u1, u2, u3):
     rx, ry, rz = -wox, -woy, woz
     max_angle, smooth, omc = _cone(cl, k)
     x, y, z = uniform_cone(u1, u2, omc)
-    tx, ty, tz, bx, by, bz = orthonormal_basis(rx, ry, rz)
-    wx = x * tx + y * bx + z * rx
-    wy = x * ty + y * by + z * ry
-    wz = x * tz + y * bz + z * rz
+    wx, wy, wz = around(rx, ry, rz, x, y, z)
     if not wz > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     pdf = uniform_cone_pdf(omc)

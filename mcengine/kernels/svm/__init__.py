@@ -48,7 +48,7 @@ from ...jit import device, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from .ao import ao_node
 from .bevel import bevel_node
-from .bump import bump_point, undisplaced_point, with_normal
+from .bump import bump_point, dpdv_node, undisplaced_point, with_normal
 from .closure_nodes import eval_closure_node
 from .color_nodes import eval_color_node
 from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
@@ -90,6 +90,7 @@ from .vector_nodes import eval_vector_node
 from .wireframe import wireframe_node
 
 _WIREFRAME = NODES["Wireframe"].code
+_DPDV = NODES["dPdv"].code
 _BEVEL = NODES["Bevel"].code
 _AO = NODES["AmbientOcclusion"].code
 
@@ -165,6 +166,8 @@ def eval_row(ops, pc, regs, sd, tex, verts, tris, local):
     if op == OP_NODE:
         if a == _WIREFRAME:         # the nodes that read the triangles themselves
             wireframe_node(regs, b, c, sd, verts, tris)
+        elif a == _DPDV:
+            dpdv_node(regs, c, sd, verts, tris)
         elif a == _BEVEL:
             bevel_node(regs, b, c, sd, tex, verts, tris, local)
         elif a == _AO:

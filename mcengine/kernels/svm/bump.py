@@ -88,6 +88,24 @@ def barycentric_step(sd, verts, tris, ex, ey, ez):
             sign * ((e1y * ez - e1z * ey) * nx + (e1z * ex - e1x * ez) * ny + (e1x * ey - e1y * ex) * nz) / den)
 
 
+@device
+def dpdv_node(regs, c, sd, verts, tris):
+    """The point's dPdv (Cycles' sd->dPdv: the triangle's third vertex less its first, negated
+    on a back face), normalised, to regs[c:]; zero off a triangle."""
+    regs[c] = regs[c + 1] = regs[c + 2] = 0.0
+    p = sd.prim
+    if p < 0:
+        return
+    t = tris[p]
+    v0, v2 = verts[t[0]], verts[t[2]]
+    x, y, z = v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]
+    length = math.sqrt(x * x + y * y + z * z)
+    if not length > 0.0:
+        return
+    s = (-1.0 if sd.backfacing else 1.0) / length
+    regs[c], regs[c + 1], regs[c + 2] = x * s, y * s, z * s
+
+
 @function
 def bump_point(sd, verts, tris, width, axis):
     """The shading point moved by ``width`` times dPdx (axis 1) or dPdy (axis 2), with its

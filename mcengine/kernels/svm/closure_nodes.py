@@ -24,6 +24,7 @@ from ..closures.ashikhmin import AS_MIN_ALPHA
 from ..closures.bssrdf import BSSRDF_MIN_RADIUS, bssrdf_radius
 from ..closures.diffuse import oren_nayar_setup
 from ..closures.fresnel import F0_from_ior, ior_from_F0
+from ..closures.hair import hair_setup
 from ..closures.layout import (
     CL_ALBEDO,
     CL_ANISOTROPY,
@@ -41,6 +42,8 @@ from ..closures.layout import (
     CL_FRESNEL,
     CL_N,
     CL_NS,
+    CL_PORTAL_D,
+    CL_PORTAL_P,
     CL_RADIUS,
     CL_RTINT,
     CL_SSS_ALBEDO,
@@ -58,11 +61,14 @@ from ..closures.layout import (
     CT_DIFFUSE,
     CT_DIFFUSE_TOON,
     CT_GLOSSY_TOON,
+    CT_HAIR_REFLECTION,
+    CT_HAIR_TRANSMISSION,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_NONE,
     CT_OREN_NAYAR,
+    CT_RAY_PORTAL,
     CT_SHEEN,
     CT_TRANSLUCENT,
     CT_TRANSPARENT,
@@ -102,14 +108,23 @@ from .nodes import (
     GL_ROUGHNESS,
     GL_THIN_FILM,
     GL_THIN_FILM_IOR,
+    H_COMPONENT,
+    H_IMPLICIT_TANGENT,
+    H_OFFSET,
+    H_ROUGHNESS_U,
+    H_ROUGHNESS_V,
+    H_TANGENT,
+    HAIR_TRANSMISSION,
     K_BACKGROUND,
     K_DIFFUSE,
     K_EMISSION,
     K_GLASS,
     K_GLOSSY,
+    K_HAIR,
     K_HOLDOUT,
     K_METALLIC,
     K_PRINCIPLED,
+    K_RAY_PORTAL,
     K_REFRACTION,
     K_SHEEN,
     K_SUBSURFACE,
@@ -165,6 +180,8 @@ from .nodes import (
     R_IOR,
     R_NORMAL,
     R_ROUGHNESS,
+    RP_DIRECTION,
+    RP_POSITION,
     S_DISTRIBUTION,
     S_NORMAL,
     S_ROUGHNESS,
@@ -408,6 +425,33 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
                 cl[k, CL_TYPE] = CT_GLOSSY_TOON if glossy_lobe else CT_DIFFUSE_TOON
                 set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
                 toon_setup(cl, k, regs[b + T_SIZE], regs[b + T_SMOOTH])
+    elif kind == K_HAIR:
+        k, n = alloc(cl, n, cr, cg, cb, sd)
+        if k >= 0:
+            nx, ny, nz = ensure_valid_reflection(sd, sd.nx, sd.ny, sd.nz)
+            tx, ty, tz = regs[b + H_TANGENT], regs[b + H_TANGENT + 1], regs[b + H_TANGENT + 2]
+            length = math.sqrt(tx * tx + ty * ty + tz * tz)
+            if length > 0.0:
+                tx, ty, tz = tx / length, ty / length, tz / length
+            implicit = regs[b + H_IMPLICIT_TANGENT] != 0.0
+            cl[k, CL_TYPE] = CT_HAIR_TRANSMISSION if regs[b + H_COMPONENT] == HAIR_TRANSMISSION \
+                else CT_HAIR_REFLECTION
+            set_frame(cl, k, nx, ny, nz, tx, ty, tz)
+            hair_setup(cl, k, tx, ty, tz, regs[b + H_ROUGHNESS_U], regs[b + H_ROUGHNESS_V],
+                       0.0 if implicit else -regs[b + H_OFFSET])
+    elif kind == K_RAY_PORTAL:
+        k, n = alloc(cl, n, cr, cg, cb, sd)
+        if k >= 0:
+            cl[k, CL_TYPE] = CT_RAY_PORTAL
+            set_frame(cl, k, sd.nx, sd.ny, sd.nz, 0.0, 0.0, 0.0)
+            for c in range(3):
+                cl[k, CL_PORTAL_P + c] = regs[b + RP_POSITION + c]
+            dx, dy, dz = regs[b + RP_DIRECTION], regs[b + RP_DIRECTION + 1], regs[b + RP_DIRECTION + 2]
+            length = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if not length > 0.0:        # no direction: straight on
+                dx, dy, dz, length = -sd.wox, -sd.woy, -sd.woz, 1.0
+            cl[k, CL_PORTAL_D], cl[k, CL_PORTAL_D + 1], cl[k, CL_PORTAL_D + 2] = \
+                dx / length, dy / length, dz / length
     elif kind == K_SUBSURFACE:
         scale = regs[b + SS_SCALE]
         nx, ny, nz = input_normal(regs, b + SS_NORMAL, sd)

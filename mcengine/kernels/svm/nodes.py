@@ -57,10 +57,13 @@ DISTRIBUTIONS = {"GGX": DIST_GGX, "MULTI_GGX": DIST_MULTI_GGX, "BECKMANN": DIST_
                  "ASHIKHMIN_SHIRLEY": DIST_ASHIKHMIN_SHIRLEY, "ASHIKHMIN": DIST_ASHIKHMIN,
                  "MICROFIBER": DIST_MICROFIBER}
 
-# The Toon BSDF's component.
+# The component of the Toon BSDF and of the Hair BSDF.
 TOON_DIFFUSE = 0
 TOON_GLOSSY = 1
-TOON_COMPONENTS = {"DIFFUSE": TOON_DIFFUSE, "GLOSSY": TOON_GLOSSY}
+HAIR_REFLECTION = 0
+HAIR_TRANSMISSION = 1
+COMPONENTS = {"DIFFUSE": TOON_DIFFUSE, "GLOSSY": TOON_GLOSSY,
+              "Reflection": HAIR_REFLECTION, "Transmission": HAIR_TRANSMISSION}
 
 # Texture settings (codes are Cycles' enum values where it has them).
 DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
@@ -210,7 +213,7 @@ SSS_METHODS = {"BURLEY": SSS_BURLEY, "RANDOM_WALK": SSS_RANDOM_WALK,
 
 ENUMS = {
     "distribution": DISTRIBUTIONS,
-    "component": TOON_COMPONENTS,
+    "component": COMPONENTS,
     "subsurface_method": SSS_METHODS,
     "falloff": SSS_METHODS,
     "fresnel_type": FRESNEL_TYPES,
@@ -257,9 +260,10 @@ UV = "uv"
 POSITION = "position"          # the point (world shaders: the ray direction)
 TANGENT = "tangent"            # the radial tangent about object Z (Geometry's Tangent)
 INCOMING = "incoming"          # towards the viewer (Geometry's Incoming)
+DPDV = "dpdv"                  # along the triangle's second edge (Cycles' sd->dPdv)
 IMPLICIT = {GENERATED: ("TexCoord", "Generated"), UV: ("TexCoord", "UV"),
             POSITION: ("NewGeometry", "Position"), TANGENT: ("NewGeometry", "Tangent"),
-            INCOMING: ("NewGeometry", "Incoming")}
+            INCOMING: ("NewGeometry", "Incoming"), DPDV: ("dPdv", "dPdv")}
 
 # Baked tables of the ColorRamp and curve nodes: Cycles samples them at RAMP_TABLE_SIZE + 1
 # evenly spaced positions (blender/util.h: colorramp_to_array, curvemapping_*_to_array).
@@ -343,6 +347,14 @@ CLOSURES = {
                                           _p("falloff", SSS_RANDOM_WALK)), _BSDF, False),
     "BsdfToon": NodeSpec(14, (_c("Color", GREY), _f("Size", 0.5), _f("Smooth", 0.0), _v("Normal"),
                               _p("component", TOON_DIFFUSE)), _BSDF, False),
+    # Hair BSDF: "prop:implicit_tangent" is 1 when nothing is linked to Tangent (on a mesh
+    # Cycles then takes dPdv, and no offset).
+    "BsdfHair": NodeSpec(15, (_c("Color", GREY), _f("Offset", 0.0), _f("RoughnessU", 0.1),
+                              _f("RoughnessV", 1.0), _v("Tangent", DPDV),
+                              _p("component", HAIR_REFLECTION), _p("implicit_tangent", 1)),
+                         _BSDF, False),
+    "BsdfRayPortal": NodeSpec(16, (_c("Color", WHITE), _v("Position", POSITION), _v("Direction")),
+                              _BSDF, False),
     "Emission": NodeSpec(9, (_c("Color", WHITE), _f("Strength", 1.0)),
                          (Socket("Emission", SHADER, None),), False),
     "Holdout": NodeSpec(10, (), (Socket("Holdout", SHADER, None),), False),
@@ -422,6 +434,8 @@ VALUE_NODES = {
                                        _p("samples", 16), _p("inside", 0), _p("only_local", 0),
                                        _p("global_distance", -1)),
                                  (_c("Color", (0, 0, 0)), _f("AO", 0.0)), False),
+    # Not a Blender node: the point's dPdv (a Hair BSDF's implicit Tangent; ``svm.bump``)
+    "dPdv": NodeSpec(117, (), (_v("dPdv"),), False),
     # -- math family: converters (svm/math_nodes.py)
     "Math": NodeSpec(201, (_f("Value", 0.5), _f("Value_001", 0.5), _f("Value_002", 0.5),
                            _p("operation", OPERATIONS["ADD"]), _p("use_clamp", 0)),
@@ -685,6 +699,11 @@ SS_NORMAL = _SS["Normal"]
 SS_FALLOFF = _SS["prop:falloff"]
 _TN = OFFSETS["BsdfToon"]
 T_SIZE, T_SMOOTH, T_NORMAL, T_COMPONENT = _TN["Size"], _TN["Smooth"], _TN["Normal"], _TN["prop:component"]
+_HB = OFFSETS["BsdfHair"]
+H_OFFSET, H_ROUGHNESS_U, H_ROUGHNESS_V, H_TANGENT = _HB["Offset"], _HB["RoughnessU"], _HB["RoughnessV"], _HB["Tangent"]
+H_COMPONENT, H_IMPLICIT_TANGENT = _HB["prop:component"], _HB["prop:implicit_tangent"]
+RP_POSITION = OFFSETS["BsdfRayPortal"]["Position"]
+RP_DIRECTION = OFFSETS["BsdfRayPortal"]["Direction"]
 E_STRENGTH = OFFSETS["Emission"]["Strength"]
 assert OFFSETS["Background"]["Strength"] == E_STRENGTH
 
@@ -698,6 +717,8 @@ K_TRANSLUCENT = KIND["BsdfTranslucent"]
 K_TRANSPARENT = KIND["BsdfTransparent"]
 K_SHEEN = KIND["BsdfSheen"]
 K_TOON = KIND["BsdfToon"]
+K_HAIR = KIND["BsdfHair"]
+K_RAY_PORTAL = KIND["BsdfRayPortal"]
 K_METALLIC = KIND["BsdfMetallic"]
 K_EMISSION = KIND["Emission"]
 K_HOLDOUT = KIND["Holdout"]

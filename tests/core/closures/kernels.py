@@ -25,6 +25,7 @@ from mcengine.kernels.closures.diffuse import (
     translucent_eval,
     translucent_sample,
 )
+from mcengine.kernels.closures.hair import hair_eval, hair_sample, hair_setup
 from mcengine.kernels.closures.layout import (
     CL_AX,
     CL_AY,
@@ -50,6 +51,8 @@ from mcengine.kernels.closures.layout import (
     CT_DIFFUSE,
     CT_DIFFUSE_TOON,
     CT_GLOSSY_TOON,
+    CT_HAIR_REFLECTION,
+    CT_HAIR_TRANSMISSION,
     CT_MICROFACET,
     CT_OREN_NAYAR,
     CT_TRANSLUCENT,
@@ -132,6 +135,14 @@ def toon_row(ctype: int, size: float, smooth: float) -> np.ndarray:
     return cl
 
 
+def hair_row(ctype: int, tangent=(1.0, 0.0, 0.0), roughness_u: float = 0.2,
+             roughness_v: float = 0.5, offset: float = 0.0) -> np.ndarray:
+    """A Hair BSDF row in the frame N = +z, T = +x, its strand along ``tangent`` (unit)."""
+    cl = empty_row(ctype)
+    hair_setup(cl, 0, *tangent, roughness_u, roughness_v, offset)
+    return cl
+
+
 def direction(theta_deg: float, phi_deg: float = 0.0) -> tuple[float, float, float]:
     t = math.radians(theta_deg)
     p = math.radians(phi_deg)
@@ -157,6 +168,8 @@ def sample_batch(cl, wox, woy, woz, u, out):
             res = diffuse_toon_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         elif t == CT_GLOSSY_TOON:
             res = glossy_toon_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
+        elif t == CT_HAIR_REFLECTION or t == CT_HAIR_TRANSMISSION:
+            res = hair_sample(cl, 0, t == CT_HAIR_TRANSMISSION, wox, woy, woz, u[i, 0], u[i, 1])
         else:
             res = microfacet_sample(cl, 0, wox, woy, woz, u[i, 0], u[i, 1], u[i, 2])
         out[i, 0], out[i, 1], out[i, 2] = res[0], res[1], res[2]
@@ -183,6 +196,8 @@ def eval_batch(cl, wox, woy, woz, wi, out):
             res = diffuse_toon_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         elif t == CT_GLOSSY_TOON:
             res = glossy_toon_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
+        elif t == CT_HAIR_REFLECTION or t == CT_HAIR_TRANSMISSION:
+            res = hair_eval(cl, 0, t == CT_HAIR_TRANSMISSION, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         else:
             res = microfacet_eval(cl, 0, wox, woy, woz, wi[i, 0], wi[i, 1], wi[i, 2])
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = res

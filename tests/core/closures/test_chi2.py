@@ -1,11 +1,12 @@
 """Chi-square goodness of fit of every closure sampler against the pdf its eval returns.
 
-132 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
+144 cases (the Sidak correction in ``chi2.ALPHA_SIDAK`` is over all of them, alpha = 0.01
 overall): Lambert, translucent and Oren-Nayar; GGX and Beckmann reflection, refraction and
 glass at eta 1.5 and 1/1.5; anisotropic GGX; GGX glass under a 400 nm thin film (coloured
 reflectance: the lobe is picked by its average); views at 0, 45 and 89 degrees; roughness
-0.05, 0.3 and 1 (alpha = roughness^2); Ashikhmin-Shirley (isotropic and anisotropic) and the
-Ashikhmin velvet.  2^18 samples each, numpy Generator seeds fixed.
+0.05, 0.3 and 1 (alpha = roughness^2); Ashikhmin-Shirley (isotropic and anisotropic), the
+Ashikhmin velvet, the Toon BSDF's two lobes and the Hair BSDF's two (the view in the plane of
+the normal and the strand).  2^18 samples each, numpy Generator seeds fixed.
 A representative subset runs by default, the whole grid with ``-m slow``.
 
 Two properties of Cycles' pdf that are not properties of its sampler are accounted for,
@@ -31,6 +32,8 @@ from mcengine.kernels.closures.layout import (
     CT_DIFFUSE,
     CT_DIFFUSE_TOON,
     CT_GLOSSY_TOON,
+    CT_HAIR_REFLECTION,
+    CT_HAIR_TRANSMISSION,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
@@ -49,6 +52,7 @@ from .kernels import (
     ashikhmin_shirley_row,
     diffuse_row,
     direction,
+    hair_row,
     microfacet_row,
     oren_nayar_row,
     toon_row,
@@ -119,6 +123,14 @@ def _case_list():
     for theta in THETAS:
         cases.append(("toon-diffuse", dict(ctype=CT_DIFFUSE_TOON, size=0.5, smooth=0.2), theta, 0.0))
         cases.append(("toon-glossy", dict(ctype=CT_GLOSSY_TOON, size=0.2, smooth=0.1), theta, 0.0))
+    # the Hair BSDF along +x, the view in the plane of the normal and the strand (where
+    # Cycles' sampling and evaluation describe the same density: reflection up to
+    # RoughnessV 0.5, transmission at any)
+    for theta in THETAS:
+        cases.append(("hair-reflection", dict(ctype=CT_HAIR_REFLECTION, r1=0.2, r2=0.45, offset=0.1),
+                      theta, 0.0))
+        cases.append(("hair-transmission", dict(ctype=CT_HAIR_TRANSMISSION, r1=0.3, r2=0.7,
+                                                offset=-0.1), theta, 0.0))
     # GGX glass under a thin film (the Glass node's Thin Film Thickness 400, IOR 1.33)
     for eta in (1.5, 1.0 / 1.5):
         for theta in THETAS:
@@ -148,6 +160,8 @@ def _row(params: dict, wo) -> np.ndarray:
         return velvet_row(p["sigma"])
     if ctype in (CT_DIFFUSE_TOON, CT_GLOSSY_TOON):
         return toon_row(ctype, p["size"], p["smooth"])
+    if ctype in (CT_HAIR_REFLECTION, CT_HAIR_TRANSMISSION):
+        return hair_row(ctype, (1.0, 0.0, 0.0), p["r1"], p["r2"], p["offset"])
     return microfacet_row(ctype=ctype, **p)
 
 
@@ -171,7 +185,7 @@ def _params():
     out = []
     for i, (name, params, theta, phi) in enumerate(CASES):
         marks = () if (i in FAST or (name.endswith("r0.3") and theta == 45.0)
-                       or (name.startswith(("velvet", "ashikhmin", "toon")) and theta == 45.0)
+                       or (name.startswith(("velvet", "ashikhmin", "toon", "hair")) and theta == 45.0)
                        or ("r0.3-eta" in name and theta == 45.0)) else (pytest.mark.slow,)
         out.append(pytest.param(params, theta, phi, id=f"{name}-th{theta:g}-ph{phi:g}", marks=marks))
     return out

@@ -279,7 +279,8 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # Light Path's Ray Length and the emission's MIS distance.
         hx, hy, hz = sp.hx - mp[0], sp.hy - mp[1], sp.hz - mp[2]
         ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
-        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
+        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i],
+                  st.portal[i])
         footprint = st.dp[i] + st.dd[i] * ray_length     # Cycles' differential_transfer_compact
         bounce = st.bounce[i]
         vertex = bounce + st.transparent[i]      # random-number dimensions of this vertex
@@ -411,6 +412,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             # bounce that keeps the path's flags; light the new ray finds is not weighted by
             # MIS (no light sample can pass a portal), its length counts from that point.
             st.transparent[i] += 1
+            st.portal[i] += 1
             flags |= PF_TRANSPARENT | PF_MIS_SKIP
             if st.transparent[i] >= max_transparent:
                 flags |= PF_TERMINATE

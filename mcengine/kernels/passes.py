@@ -51,10 +51,12 @@ from .closures.layout import (
     CL_W,
     CT_ASHIKHMIN_SHIRLEY,
     CT_BSSRDF,
+    CT_HAIR_TRANSMISSION,
     CT_MICROFACET,
     CT_MICROFACET_GLASS,
     CT_MICROFACET_REFRACTION,
     CT_NONE,
+    CT_RAY_PORTAL,
     CT_TRANSPARENT,
     LABEL_REFLECT,
     ROUGHNESS_SQ_THRESHOLD,
@@ -164,10 +166,10 @@ def closure_albedo(cl, k, wox, woy, woz, reflection, transmission):
 
 @device
 def roughness_squared(cl, k):
-    """Cycles' bsdf_get_specular_roughness_squared: ax * ay of a microfacet, 0 if singular,
-    1 for every other closure."""
+    """Cycles' bsdf_get_specular_roughness_squared: ax * ay of a microfacet, 0 if singular
+    (transparent and ray portal closures too), 1 for every other closure."""
     t = cl[k, CL_TYPE]
-    if t == CT_TRANSPARENT:
+    if t == CT_TRANSPARENT or t == CT_RAY_PORTAL:
         return 0.0
     if t == CT_MICROFACET or t == CT_MICROFACET_REFRACTION or t == CT_MICROFACET_GLASS \
             or t == CT_ASHIKHMIN_SHIRLEY:
@@ -463,7 +465,7 @@ def _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl
                 o, refl, trans = c[P_DIFFUSE_COLOR], True, True
             elif is_glossy_reflection(t):
                 o, refl, trans = c[P_GLOSSY_COLOR], True, False
-            elif t == CT_MICROFACET_REFRACTION:
+            elif t == CT_MICROFACET_REFRACTION or t == CT_HAIR_TRANSMISSION:
                 o, refl, trans = c[P_TRANSMISSION_COLOR], False, True
             elif t == CT_MICROFACET_GLASS:
                 # Glass adds its reflection to the glossy colour, its transmission to the other.

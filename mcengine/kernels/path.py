@@ -32,6 +32,7 @@ import numpy as np
 
 from ..jit import device, function, kernel
 from .camera import generate_camera_rays
+from .closures import portal_weight
 from .closures.layout import (
     CL_ANISOTROPY,
     CL_AX,
@@ -342,10 +343,11 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
 
             # -- render passes written at the surface (data passes, denoising features) --------
             if surface_pass_work:
+                qr, qg, qb = portal_weight(scratch.cl, ncl)    # a portal counts as transparent
                 flags = surface_passes(pd, fp, st.pixel[i], flags, sp.hx, sp.hy, sp.hz, sp.nsx,
                                        sp.nsy, sp.nsz, t_hit, p, b1, b2, m, scratch.cl, ncl,
-                                       st.beta[i, 0], st.beta[i, 1], st.beta[i, 2], rtr, rtg, rtb,
-                                       -dx, -dy, -dz, pb, i)
+                                       st.beta[i, 0], st.beta[i, 1], st.beta[i, 2], rtr + qr,
+                                       rtg + qg, rtb + qb, -dx, -dy, -dz, pb, i)
                 st.flags[i] = flags
         key = st.key[i]
         if ao and (flags & PF_CAMERA):

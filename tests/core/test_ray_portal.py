@@ -132,3 +132,18 @@ def test_light_path_counts_the_portals_passed():
                         surface=Link(3, "Shader"))
     rgb, _ = _rgba(render(_scene(material)))
     np.testing.assert_allclose(rgb, COLOR, rtol=1e-6)
+
+
+@pytest.mark.parametrize("kind", ["BsdfRayPortal", "BsdfTransparent"])
+def test_data_passes_look_through_portals(kind):
+    """Cycles writes the data passes at the first surface at least as opaque as the view
+    layer's alpha threshold, counting a portal as transparent: the Depth pass of the floor
+    seen through the sheet is the floor's, 5 m (the sheet's would be 4)."""
+    from mcengine.passes import RenderPasses
+    from mcengine.session import RenderSession
+
+    scene = _floor_under_sheet(kind, samples=4)
+    scene.passes = RenderPasses(enabled=("Depth",))
+    session = RenderSession(scene)
+    session.run()
+    np.testing.assert_allclose(session.pass_image("Depth"), 5.0, rtol=1e-6)

@@ -297,6 +297,17 @@ def closure_sample(cl, k, wox, woy, woz, u1, u2, u3):
 
 
 @device
+def portal_weight(cl, n):
+    """The summed weight (r, g, b) of the Ray Portal closures among the first n: Cycles counts
+    it in the transparency the data passes see (surface_shader_transparency)."""
+    r = g = b = 0.0
+    for k in range(n):
+        if cl[k, CL_TYPE] == CT_RAY_PORTAL:
+            r, g, b = r + cl[k, CL_W], g + cl[k, CL_W + 1], b + cl[k, CL_W + 2]
+    return r, g, b
+
+
+@device
 def excluded(t, exclude):
     """Whether a light's ray-visibility switches (``exclude``, LABEL_* bits) hide
     closures of type t from it (Cycles' _surface_shader_exclude)."""

@@ -586,7 +586,7 @@ _ATTRIBUTE_READERS = {"Attribute": ("", "attribute_name"), "UVMap": ("", "uv_map
 # What the compiler shows a node it evaluates ahead of time: no point, no scene (and, public,
 # what a program run on the host without a scene reads: tests/core/test_closure_rows.py).
 _HOST_POINT = ShadingData(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
-                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0, 0.0,
+                          False, True, True, True, -1, 0.0, 0.0, -1, 0, 0.0, 0, 0, 0, 0, 0, 0.0,
                           np.uint64(0), 0.0)
 NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros((0, 3, 3), np.float32),
                           tri_object=np.zeros(0, np.int32),

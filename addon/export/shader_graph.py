@@ -253,6 +253,9 @@ class GraphReader:
         kind = node_type(target)
         spec = NODES.get(kind)
         feature = f"{kind} node"
+        if kind == "LightPath" and out.identifier == "Portal Depth":
+            self.note(f"{label(target)} 'Portal Depth' into {label(node)}", "Light Path Portal Depth",
+                      "Portal Depth read as 0 (ray portals passed are not counted)")
         if kind == "TexSky" and target.sky_type not in SKY_TYPES:
             spec, feature = None, f"Sky Texture type {target.sky_type}"
         if spec is None or spec.outputs and spec.outputs[0].type == "shader":

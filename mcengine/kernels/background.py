@@ -51,7 +51,7 @@ def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
     x, y, z = np.float64(dx), np.float64(dy), np.float64(dz)
     sd = ShadingData(x, y, z, -x, -y, -z, -x, -y, -z, -x, -y, -z, False, False, True, True, False,
                      i64(-1), 0.0, 0.0, i64(-1), i64(flags), math.inf,
-                     i64(0), i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
+                     i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
     w = sc.mat_prog.shape[0] - 1
     res = eval_shader(sc.svm_ops, sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs,
                       scratch.cl_light, sd, sc.tex, sc.verts, sc.tris, sc.local)

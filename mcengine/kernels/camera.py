@@ -398,7 +398,6 @@ def generate_camera_rays(pixels, spp, sample_base, st, sc, cfg):
             st.glossy[n] = 0
             st.transmission[n] = 0
             st.transparent[n] = 0
-            st.portal[n] = 0
             st.flags[n] = PF_CAMERA | PF_MIS_SKIP | PF_TRANSPARENT_BG | (PF_FIRST_SAMPLE if sample == 0 else 0)
             st.mis_pdf[n] = 0.0
             st.mis_p[n, 0], st.mis_p[n, 1], st.mis_p[n, 2] = ox, oy, oz   # ray length from here

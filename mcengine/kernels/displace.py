@@ -42,7 +42,7 @@ def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, local, ng
                          f64(ng[t, 0]), f64(ng[t, 1]), f64(ng[t, 2]), nx, ny, nz,
                          False, False, True, True, False, i64(t), u, v,
                          i64(tex.tri_object[t]), i64(0), 0.0,
-                         i64(0), i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
+                         i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
         eval_values(ops, ranges[m, 0], ranges[m, 1], regs, sd, tex, verts, tris, local)
         r = results[m]
         for c in range(3):

@@ -213,7 +213,6 @@ def start_light_paths(pixels, spp, sample_base, st, sc, cfg, emit_cdf, emit_pmf,
             st.glossy[n] = 0
             st.transmission[n] = 0
             st.transparent[n] = 0
-            st.portal[n] = 0
             st.flags[n] = 0
             st.self_prim[n] = -1
             st.alive[n] = 1
@@ -247,7 +246,7 @@ def _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t, flags):
     """Triangle p's closures at (b1, b2) for a viewer at -d (to ``scratch.cl``)."""
     sp = surface_point(sc, p, b1, b2, dx, dy, dz, _TIME)
     res = shade_point(sc, cfg, scratch, sp, sc.mat_index[p], p, b1, b2, dx, dy, dz, t, flags, True,
-                      (0, 0, 0, 0, 0, 0), 0.0)
+                      (0, 0, 0, 0, 0), 0.0)
     return sp, res
 
 

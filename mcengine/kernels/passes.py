@@ -41,7 +41,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import device, function
-from .closures import closure_eval, excluded, is_diffuse, is_glossy_reflection
+from .closures import closure_eval, excluded, is_diffuse, is_glossy_reflection, portal_weight
 from .closures.layout import (
     CL_AX,
     CL_AY,
@@ -388,9 +388,12 @@ def _crypto_add(fp, pix, base, slots, ident, weight):
 def surface_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, t_hit, p, b1, b2, m, cl, ncl,
                    br, bg, bb, tr, tg, tb, wox, woy, woz, pb, i):
     """Data passes and denoising features at a surface path i reached (after emission and
-    Russian roulette, as in Cycles' shade_surface); returns the path's new flags."""
+    Russian roulette, as in Cycles' shade_surface), where (tr, tg, tb) is the transparency
+    of its closures; returns the path's new flags."""
     c = pd.cfg
     if c[PC_DATA] and (flags & PF_TRANSPARENT_BG):
+        qr, qg, qb = portal_weight(cl, ncl)        # Cycles counts a portal as transparent
+        tr, tg, tb = tr + qr, tg + qg, tb + qb
         flags = _data_passes(pd, fp, pix, flags, hx, hy, hz, nsx, nsy, nsz, p, b1, b2, m, cl,
                              ncl, br, bg, bb, tr, tg, tb, wox, woy, woz)
     if c[PC_DENOISE] and (flags & PF_DENOISE):

@@ -32,7 +32,6 @@ import numpy as np
 
 from ..jit import device, function, kernel
 from .camera import generate_camera_rays
-from .closures import portal_weight
 from .closures.layout import (
     CL_ANISOTROPY,
     CL_AX,
@@ -280,8 +279,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # Light Path's Ray Length and the emission's MIS distance.
         hx, hy, hz = sp.hx - mp[0], sp.hy - mp[1], sp.hz - mp[2]
         ray_length = math.sqrt(hx * hx + hy * hy + hz * hz)
-        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i],
-                  st.portal[i])
+        depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
         footprint = st.dp[i] + st.dd[i] * ray_length     # Cycles' differential_transfer_compact
         bounce = st.bounce[i]
         vertex = bounce + st.transparent[i]      # random-number dimensions of this vertex
@@ -343,11 +341,10 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
 
             # -- render passes written at the surface (data passes, denoising features) --------
             if surface_pass_work:
-                qr, qg, qb = portal_weight(scratch.cl, ncl)    # a portal counts as transparent
                 flags = surface_passes(pd, fp, st.pixel[i], flags, sp.hx, sp.hy, sp.hz, sp.nsx,
                                        sp.nsy, sp.nsz, t_hit, p, b1, b2, m, scratch.cl, ncl,
-                                       st.beta[i, 0], st.beta[i, 1], st.beta[i, 2], rtr + qr,
-                                       rtg + qg, rtb + qb, -dx, -dy, -dz, pb, i)
+                                       st.beta[i, 0], st.beta[i, 1], st.beta[i, 2], rtr, rtg, rtb,
+                                       -dx, -dy, -dz, pb, i)
                 st.flags[i] = flags
         key = st.key[i]
         if ao and (flags & PF_CAMERA):
@@ -414,7 +411,6 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             # bounce that keeps the path's flags; light the new ray finds is not weighted by
             # MIS (no light sample can pass a portal), its length counts from that point.
             st.transparent[i] += 1
-            st.portal[i] += 1
             flags |= PF_TRANSPARENT | PF_MIS_SKIP
             if st.transparent[i] >= max_transparent:
                 flags |= PF_TERMINATE

@@ -226,7 +226,7 @@ def push_shadow(sq, sc, n_shadow, owner, sp, nx, ny, nz, wix, wiy, wiz, dist, ln
     sq.target[n_shadow, 0], sq.target[n_shadow, 1], sq.target[n_shadow, 2] = ex, ey, ez
     sq.transparent[n_shadow] = transparent_left
     sq.alive[n_shadow] = 1
-    for k in range(6):
+    for k in range(5):
         sq.depths[n_shadow, k] = depths[k]
     sq.travelled[n_shadow] = 0.0
     sq.kind[n_shadow] = SK_NONE
@@ -335,8 +335,7 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
                        -f64(dx), -f64(dy), -f64(dz), bool(sp.backfacing), bool(allocate),
                        bool(reflective), bool(refractive), bool(bump), i64(prim), f64(b1), f64(b2),
                        i64(obj), i64(flags), f64(ray_length), i64(depths[0]), i64(depths[1]),
-                       i64(depths[2]), i64(depths[3]), i64(depths[4]), i64(depths[5]), f64(dp),
-                       np.uint64(rng),
+                       i64(depths[2]), i64(depths[3]), i64(depths[4]), f64(dp), np.uint64(rng),
                        f64(min_pdf))
 
 
@@ -414,7 +413,7 @@ def emission_estimates(sc, scratch, tris, out):
             b1, b2 = points[k]
             er, eg, eb = emission_at(sc, scratch, t, b1, b2, -sc.tri_normal[t, 0],
                                      -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0,
-                                     (0, 0, 0, 0, 0, 0), 0.5)
+                                     (0, 0, 0, 0, 0), 0.5)
             r += er
             g += eg
             b += eb

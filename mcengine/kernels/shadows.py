@@ -91,7 +91,7 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         # the transparent surfaces passed so far (Cycles' shadow path state).
         dep = sq.depths[s]
         res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, sq.travelled[s] + t,
-                          PF_SHADOW, False, (dep[0], dep[1], dep[2], dep[3], dep[4], dep[5]), 0.0)
+                          PF_SHADOW, False, (dep[0], dep[1], dep[2], dep[3], dep[4]), 0.0)
         dep[4] += 1
         sq.contrib[s, 0] *= res.tr
         sq.contrib[s, 1] *= res.tg

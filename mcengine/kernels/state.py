@@ -31,7 +31,6 @@ PathState = namedtuple("PathState", [
     "glossy",        # (B,) int32
     "transmission",  # (B,) int32
     "transparent",   # (B,) int32    transparent passes (lamps count as one)
-    "portal",        # (B,) int32    ray portals passed (Light Path's Portal Depth)
     "flags",         # (B,) int32    PF_* bits
     "mis_pdf",       # (B,) f64      pdf of the BSDF sample that made the current ray
     "min_pdf",       # (B,) f64      smallest BSDF pdf on the path so far (Filter Glossy)
@@ -65,9 +64,9 @@ ShadowQueue = namedtuple("ShadowQueue", [
     "target",              # (B, 3) f64  end point of the ray (transparent shadows re-aim at it)
     "transparent",         # (B,) int32  transparent bounces the path may still make
     "alive",               # (B,) uint8  still being traced (transparent shadows)
-    "depths",              # (B, 6) int32  the path's bounces when the ray left (all, diffuse,
-                           #               glossy, transmission, transparent, portal; transparent
-                           #               surfaces passed add to the fifth: Light Path node)
+    "depths",              # (B, 5) int32  the path's bounces when the ray left (all, diffuse,
+                           #               glossy, transmission, transparent; transparent
+                           #               surfaces passed add to the last: Light Path node)
     "travelled",           # (B,) f64    distance from the shading point to the current origin
     "kind",                # (B,) int8   what the ray's light is for (SK_*)
 ])
@@ -219,7 +218,7 @@ def alloc_path_state(n: int) -> PathState:
         beta=np.zeros((n, 3)), radiance=np.zeros((n, 3)), transparency=np.zeros(n),
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
-        transparent=np.zeros(n, np.int32), portal=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
+        transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
         mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 6)), self_prim=np.zeros(n, np.int32),
         mis_set=np.zeros(n, np.int32),
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
@@ -249,7 +248,6 @@ def move_path(st, i, m):
     st.glossy[m] = st.glossy[i]
     st.transmission[m] = st.transmission[i]
     st.transparent[m] = st.transparent[i]
-    st.portal[m] = st.portal[i]
     st.flags[m] = st.flags[i]
     st.mis_pdf[m] = st.mis_pdf[i]
     st.min_pdf[m] = st.min_pdf[i]
@@ -267,7 +265,7 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
                        t32=np.zeros(n, np.float32), contrib=np.zeros((n, 3)),
                        path=np.zeros(n, np.int32), time=np.zeros(n), target=np.zeros((n, 3)),
                        transparent=np.zeros(n, np.int32), alive=np.zeros(n, np.uint8),
-                       depths=np.zeros((n, 6), np.int32), travelled=np.zeros(n),
+                       depths=np.zeros((n, 5), np.int32), travelled=np.zeros(n),
                        kind=np.zeros(n, np.int8))
 
 

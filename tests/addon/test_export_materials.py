@@ -429,3 +429,18 @@ def test_ashikhmin_distributions_are_exported_unwarned(scene, fake_session, bl_i
     out, warnings = exported(fake_session, mat)
     assert warnings == []
     assert surface(out).props["distribution"] == distribution
+
+
+def test_portal_depth_is_warned_where_a_material_reads_it(scene, fake_session):
+    """Light Path's Portal Depth reads 0 (portals are not counted): a material that reads it
+    is named in a warning; one that reads only Ray Depth is not."""
+    mat = bpy.data.materials.new("Portals")
+    mix = replace_surface(mat, "ShaderNodeMixShader")
+    light_path = mat.node_tree.nodes.new("ShaderNodeLightPath")
+    link = mat.node_tree.links.new(light_path.outputs["Ray Depth"], mix.inputs["Fac"])
+    _, warnings = exported(fake_session, mat)
+    assert not [w for w in warnings if "Portal Depth" in w]
+    mat.node_tree.links.remove(link)
+    mat.node_tree.links.new(light_path.outputs["Portal Depth"], mix.inputs["Fac"])
+    _, warnings = exported(fake_session, mat)
+    assert [w for w in warnings if "Portal Depth" in w], warnings

@@ -50,7 +50,7 @@ def _scene():
 def _point(key, min_pdf=math.inf):
     """A camera ray's shading point on the floor at (0, -20, 0), normal +z (triangle 0)."""
     return ShadingData(0.0, -20.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False, True,
-                       True, True, False, 0, 0.0, 0.0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0, 0.0,
+                       True, True, False, 0, 0.0, 0.0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0.0,
                        np.uint64(node_key(np.uint64(777), key)), float(min_pdf))
 
 

@@ -45,7 +45,7 @@ def _top_point(x, y=0.0, key=0, min_pdf=math.inf):
     """A camera ray's shading point on the box's top face (normal +z) at (x, y)."""
     top = 2                   # the top face's first triangle (its barycentrics go unread)
     return ShadingData(float(x), float(y), 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, False,
-                       True, True, True, False, top, 0.0, 0.0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0, 0.0,
+                       True, True, True, False, top, 0.0, 0.0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0.0,
                        np.uint64(node_key(np.uint64(12345), key)), float(min_pdf))
 
 

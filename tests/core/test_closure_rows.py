@@ -80,7 +80,7 @@ def _points(count, seed=1):
             wo = -wo
         yield ShadingData(*rng.normal(size=3), *n, *n, *wo, bool(rng.integers(2)), True,
                           bool(rng.integers(2)), bool(rng.integers(2)), True, -1, 0.0, 0.0, -1,
-                          0, 1.0, 1, 0, 0, 0, 0, 0, 0.0, np.uint64(0), 0.0)
+                          0, 1.0, 1, 0, 0, 0, 0, 0.0, np.uint64(0), 0.0)
 
 
 def test_closure_rows_give_what_the_shader_gives(table):

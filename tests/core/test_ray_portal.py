@@ -118,22 +118,6 @@ def test_the_classic_integrators_say_they_do_not_follow_portals(name):
     assert [w for w in RenderSession(scene).warnings if "Ray Portal" in w]
 
 
-def test_light_path_counts_the_portals_passed():
-    """A plane whose shader is a portal back onto itself (from z = 2 straight down) while
-    Light Path's Portal Depth is 0 and an emission of 1 from then on: every camera ray passes
-    the portal once and then sees the emission, times the portal's Color.  Without the
-    count it would pass the portal until the transparent-bounce limit: black."""
-    material = Material(nodes=[ShaderNode("LightPath"),
-                               _portal((0.0, 0.0, 2.0), (0.0, 0.0, -1.0)),
-                               ShaderNode("Emission", {"Color": (1.0, 1.0, 1.0), "Strength": 1.0}),
-                               ShaderNode("MixShader", {"Fac": Link(0, "Portal Depth"),
-                                                        "Shader": Link(1, "BSDF"),
-                                                        "Shader_001": Link(2, "Emission")})],
-                        surface=Link(3, "Shader"))
-    rgb, _ = _rgba(render(_scene(material)))
-    np.testing.assert_allclose(rgb, COLOR, rtol=1e-6)
-
-
 @pytest.mark.parametrize("kind", ["BsdfRayPortal", "BsdfTransparent"])
 def test_data_passes_look_through_portals(kind):
     """Cycles writes the data passes at the first surface at least as opaque as the view

@@ -120,7 +120,7 @@ def bump_point(sd, verts, tris, width, axis):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u + du, sd.v + dv, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, sd.portal_depth, sd.dp, sd.rng, sd.min_pdf)
+                       sd.transmission_depth, sd.transparent_depth, sd.dp, sd.rng, sd.min_pdf)
 
 
 # A Bump node's state block on truly displaced meshes (register b of its ``OP_BUMP`` rows
@@ -190,7 +190,7 @@ def undisplaced_point(sd, verts, tris, regs, s, axis, tex):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, u + du, v + dv, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, sd.portal_depth, dp, sd.rng, sd.min_pdf)
+                       sd.transmission_depth, sd.transparent_depth, dp, sd.rng, sd.min_pdf)
 
 
 @device
@@ -200,7 +200,7 @@ def with_normal(sd, nx, ny, nz):
                        sd.wox, sd.woy, sd.woz, sd.backfacing, sd.allocate, sd.reflective_caustics,
                        sd.refractive_caustics, sd.bump_correction, sd.prim, sd.u, sd.v, sd.obj,
                        sd.path_flags, sd.ray_length, sd.depth, sd.diffuse_depth, sd.glossy_depth,
-                       sd.transmission_depth, sd.transparent_depth, sd.portal_depth, sd.dp, sd.rng, sd.min_pdf)
+                       sd.transmission_depth, sd.transparent_depth, sd.dp, sd.rng, sd.min_pdf)
 
 
 @function

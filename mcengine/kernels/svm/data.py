@@ -26,7 +26,6 @@ ShadingData = namedtuple("ShadingData", [
     "ray_length",              # length of the ray that arrived here
     "depth",                   # bounces so far, and per kind (Light Path node)
     "diffuse_depth", "glossy_depth", "transmission_depth", "transparent_depth",
-    "portal_depth",            # ray portals passed
     "dp",                      # the ray differential's footprint here (Cycles' compact sd->dP:
                                # dPdx, dPdy are dp times two unit tangents; 0: no differential)
     "rng",                     # key of the numbers ray-traced nodes (Bevel, AO) draw here

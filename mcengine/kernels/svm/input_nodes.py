@@ -372,7 +372,7 @@ def light_path(regs, c, sd):
     regs[c + 11] = sd.glossy_depth
     regs[c + 12] = sd.transparent_depth
     regs[c + 13] = sd.transmission_depth
-    regs[c + 14] = sd.portal_depth
+    regs[c + 14] = 0.0                      # Portal Depth: not counted (warned by the export)
 
 
 @device

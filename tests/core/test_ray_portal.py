@@ -54,11 +54,21 @@ def test_a_portal_sends_camera_rays_on_from_its_point_in_its_direction():
 
 
 def test_a_portal_back_into_itself_ends_at_the_transparent_bounce_limit():
-    """From z = 2 straight down onto the plane again: every pass is a transparent bounce, so
-    the path ends (black) when they reach the limit, instead of looping."""
-    material = Material(nodes=[_portal((0.0, 0.0, 2.0), (0.0, 0.0, -1.0))], surface=Link(0, "BSDF"))
-    rgb, _ = _rgba(render(_scene(material)))
-    np.testing.assert_array_equal(rgb, 0.0)
+    """From z = 2 straight down onto the plane again, which also emits 1: every pass is a
+    transparent bounce, and the one that reaches Transparent Max Bounces (8) ends the path at
+    the next surface, after its emission (Cycles' PATH_RAY_TERMINATE_ON_NEXT_SURFACE).  So
+    the emission is collected 9 times, the k-th times Color^k: (1 - c^9) / (1 - c), 9 where
+    c = 1; without the limit the blue channel would count every pass the kernel allows."""
+    material = Material(nodes=[_portal((0.0, 0.0, 2.0), (0.0, 0.0, -1.0)),
+                               ShaderNode("Emission", {"Color": (1.0, 1.0, 1.0), "Strength": 1.0}),
+                               ShaderNode("AddShader", {"Shader": Link(0, "BSDF"),
+                                                        "Shader_001": Link(1, "Emission")})],
+                        surface=Link(2, "Shader"))
+    scene = _scene(material)
+    assert scene.integrator.transparent_max_bounces == 8
+    rgb, _ = _rgba(render(scene))
+    expected = [sum(c ** k for k in range(9)) for c in COLOR]
+    np.testing.assert_allclose(rgb, expected, rtol=1e-6)
 
 
 def test_a_portal_mixed_with_a_diffuse_surface_keeps_the_estimate_unbiased():

@@ -22,8 +22,9 @@ earlier default, Single Scattering (Nishita's model over 21 wavelengths,
 ``single_scattering_image``), fills the same kind of image: the upper half with light
 scattered once, the lower half with the horizon's colour fading to black.  The shader
 (``kernels/svm/image_nodes.py``, ``sky_texture_node``) reads the image by direction, adds
-the disc and converts XYZ to the working space; ``sky_images`` makes the images of a scene's
-Sky Texture nodes for its image table, named by ``image_name``; ``sun_guide`` the sun cone
+the disc and converts XYZ to the working space.  The legacy Preetham type (an analytic fit,
+``preetham_image``) fills the same kind of image and has no disc.  ``sky_images`` makes the
+images of a scene's Sky Texture nodes for its image table, named by ``image_name``; ``sun_guide`` the sun cone
 that next-event estimation samples beside the world's map (Cycles' sun guiding).
 """
 from __future__ import annotations
@@ -36,10 +37,10 @@ import numpy as np
 from .scene import Image, SceneDescription
 
 __all__ = ["SKY_TYPES", "disc_solid_angle", "earth_intersection_angle", "image_name", "node_image", "node_parameters",
-           "single_scattering_image", "single_scattering_sun_xyz", "sky_image", "sky_images",
-           "sun_disc_xyz", "sun_guide", "sun_position"]
+           "preetham_image", "preetham_xyz", "single_scattering_image", "single_scattering_sun_xyz",
+           "sky_image", "sky_images", "sun_disc_xyz", "sun_guide", "sun_position"]
 
-SKY_TYPES = ("MULTIPLE_SCATTERING", "SINGLE_SCATTERING")    # the node's types MC Engine renders
+SKY_TYPES = ("MULTIPLE_SCATTERING", "SINGLE_SCATTERING", "PREETHAM")   # the node's types MC Engine renders
 IMAGE_SIZE = (512, 256)                     # Cycles' SkyLoader
 
 EARTH_RADIUS = 6371.0                       # km
@@ -452,6 +453,87 @@ def single_scattering_sun_xyz(sun_elevation, angular_diameter, altitude, air, ae
     return out[0], out[1]
 
 
+# -- Preetham ----------------------------------------------------------------------------------
+# "A Practical Analytic Model for Daylight" (Preetham, Shirley, Smits 1999), as Cycles 5.0
+# precomputes it (scene/shader_nodes.cpp, sky_texture_precompute_preetham) and evaluates it
+# (kernel/svm/sky.h, sky_radiance_preetham).  Each of Y, x and y is a Perez function
+# (1 + A e^(B / cos theta)) (1 + C e^(D gamma) + E cos^2 gamma) of the view's zenith angle theta
+# and its angle gamma from the sun, with A..E linear in the turbidity T (rows: A..E, columns:
+# the factor of T and the constant).
+PREETHAM_PEREZ = np.array([
+    [[0.1787, -1.4630], [-0.3554, 0.4275], [-0.0227, 5.3251], [0.1206, -2.5771], [-0.0670, 0.3703]],
+    [[-0.0193, -0.2592], [-0.0665, 0.0008], [-0.0004, 0.2125], [-0.0641, -0.8989], [-0.0033, 0.0452]],
+    [[-0.0167, -0.2608], [-0.0950, 0.0092], [-0.0079, 0.2102], [-0.0441, -1.6537], [-0.0109, 0.0529]],
+])
+# The zenith's chromaticity x and y: a cubic in the sun's zenith angle for each of T^2, T, 1
+# (columns: theta^3, theta^2, theta, 1).
+PREETHAM_ZENITH_XY = np.array([
+    [[0.00166, -0.00375, 0.00209, 0.0], [-0.02903, 0.06377, -0.03202, 0.00394],
+     [0.11693, -0.21196, 0.06052, 0.25886]],
+    [[0.00275, -0.00610, 0.00317, 0.0], [-0.04214, 0.08970, -0.04153, 0.00516],
+     [0.15346, -0.26756, 0.06670, 0.26688]],
+])
+PREETHAM_HORIZON = math.pi / 2 - 0.001     # the view's zenith angle is clamped to this
+PREETHAM_DEFAULTS = {"sun_direction": (0.0, 0.0, 1.0), "turbidity": 2.2}
+
+
+def _perez(config, cos_theta, gamma):
+    """The Perez function of ``config`` (A..E) at cos theta and gamma (arrays).  Below a
+    turbidity of about 1.2 the luminance's B is positive and the function explodes towards
+    the horizon (the clamped theta keeps it finite for the node's turbidities, 1 to 10); in
+    Cycles too, where the image's interpolation near the horizon cannot follow it."""
+    a, b, c, d, e = config
+    cg = np.cos(gamma)
+    return ((1.0 + a * np.exp(b / cos_theta))
+            * (1.0 + c * np.exp(d * gamma) + e * cg * cg))
+
+
+def preetham_sun(sun_direction) -> tuple[float, float]:
+    """The sun's zenith angle and azimuth (atan2(y, x)) from the node's Sun Direction,
+    normalised as Blender's sync does (a zero vector: the zenith)."""
+    x, y, z = (float(v) for v in sun_direction)
+    length = math.sqrt(x * x + y * y + z * z)
+    if length == 0.0:
+        return 0.0, 0.0
+    return math.acos(min(max(z / length, -1.0), 1.0)), math.atan2(y, x)
+
+
+def preetham_xyz(cos_theta, gamma, sun_theta, turbidity) -> np.ndarray:
+    """CIE XYZ (..., 3) of the Preetham sky at views of zenith cosine ``cos_theta`` and angle
+    ``gamma`` from a sun at zenith angle ``sun_theta``; the view's theta is clamped to just
+    above the horizon (below it the sky repeats the horizon's row, by gamma)."""
+    t = float(turbidity)
+    ts = float(sun_theta)
+    config = PREETHAM_PEREZ @ np.array([t, 1.0])                 # (Y, x, y) x (A..E)
+    chi = (4.0 / 9.0 - t / 120.0) * (math.pi - 2.0 * ts)
+    zenith_y = ((4.0453 * t - 4.9710) * math.tan(chi) - 0.2155 * t + 2.4192) * 0.06
+    zenith_xy = PREETHAM_ZENITH_XY @ np.array([ts ** 3, ts ** 2, ts, 1.0]) @ np.array([t * t, t, 1.0])
+    zenith = np.array([zenith_y, *zenith_xy])
+    zenith = zenith / np.array([_perez(c, 1.0, ts) for c in config])
+    cos_theta = np.maximum(np.asarray(cos_theta, np.float64), math.cos(PREETHAM_HORIZON))
+    big_y, x, y = (zenith[k] * _perez(config[k], cos_theta, gamma) for k in range(3))
+    safe_y = np.where(y != 0.0, y, 1.0)
+    big_x = np.where(y != 0.0, x / safe_y * big_y, 0.0)
+    big_z = np.where((y != 0.0) & (big_y != 0.0), (1.0 - x - y) / safe_y * big_y, 0.0)
+    return np.stack([big_x, big_y, big_z], axis=-1)
+
+
+def preetham_image(sun_theta, turbidity, size=IMAGE_SIZE):
+    """The Preetham sky as the shader reads it: (height, width, 3) XYZ on the grid of
+    ``sky_image`` (columns by azimuth from the sun's opposite, rows square-spaced in
+    elevation), for a sun at zenith angle ``sun_theta``."""
+    width, height = size
+    azimuth = 2.0 * math.pi * (np.arange(width) + 0.5) / width - math.pi     # from the sun
+    row = 2.0 * (np.arange(height) + 0.5) / height - 1.0
+    elevation = np.copysign(row * row, row) * (math.pi / 2)
+    cos_theta = np.sin(elevation)[:, None]
+    sin_theta = np.cos(elevation)[:, None]
+    cos_gamma = (sin_theta * math.sin(sun_theta) * np.cos(azimuth)[None, :]
+                 + cos_theta * math.cos(sun_theta))
+    gamma = np.arccos(np.clip(cos_gamma, -1.0, 1.0))
+    return preetham_xyz(np.broadcast_to(cos_theta, gamma.shape), gamma, sun_theta, turbidity)
+
+
 # -- the node --------------------------------------------------------------------------------
 MIN_SUN_SIZE = 0.0005        # radians: Cycles clamps the sun's angular diameter to this
 # The node's settings as Blender 5.0 creates it (what a property missing from a node reads).
@@ -493,10 +575,25 @@ def _atmosphere(props: dict) -> tuple:
                          for name in ("altitude", "air_density", "aerosol_density", "ozone_density")))
 
 
+def _preetham_settings(props: dict) -> tuple[float, float, float]:
+    """(sun zenith angle, sun azimuth, turbidity) of a Preetham sky."""
+    theta, azimuth = preetham_sun(props.get("sun_direction", PREETHAM_DEFAULTS["sun_direction"]))
+    return theta, azimuth, float(props.get("turbidity", PREETHAM_DEFAULTS["turbidity"]))
+
+
+def _image_key(props: dict) -> tuple:
+    """What the node's sky image depends on besides its type: the atmosphere, or the
+    Preetham sun's zenith angle and the turbidity (the image is laid out about the sun)."""
+    if _sky_type(props) == "PREETHAM":
+        theta, _, turbidity = _preetham_settings(props)
+        return theta, turbidity
+    return _atmosphere(props)
+
+
 def image_name(props: dict) -> str:
     """The name of the sky image a Sky Texture node with these properties reads (one image
     per atmosphere, shared by the nodes that have the same)."""
-    return f".sky {_sky_type(props).lower()} " + " ".join(f"{v:.9g}" for v in _atmosphere(props))
+    return f".sky {_sky_type(props).lower()} " + " ".join(f"{v:.9g}" for v in _image_key(props))
 
 
 def node_image(node) -> str:
@@ -510,7 +607,14 @@ def node_image(node) -> str:
 def node_parameters(props: dict) -> dict:
     """The Sky Texture's kernel properties (``kernels.svm.nodes``, "TexSky"): the sun's
     wrapped elevation and rotation, its angular diameter (-1: no disc), intensity, the
-    horizon's elevation and the disc's XYZ at its bottom and top."""
+    horizon's elevation and the disc's XYZ at its bottom and top.  A Preetham sky has no disc;
+    its rotation puts its sun where the image has it (see ``preetham_image``)."""
+    if _sky_type(props) == "PREETHAM":
+        theta, azimuth, _ = _preetham_settings(props)
+        out = {"sky_elevation": math.pi / 2 - theta, "sky_rotation": azimuth - math.pi / 2,
+               "sky_diameter": -1.0, "sun_intensity": 1.0, "sky_horizon": 0.0}
+        out.update({f"sky_{end}_{axis}": 0.0 for end in ("bottom", "top") for axis in "xyz"})
+        return out
     elevation, rotation = sun_position(_setting(props, "sun_elevation"),
                                        _setting(props, "sun_rotation"))
     _, altitude, air, aerosol, ozone = _atmosphere(props)
@@ -530,9 +634,10 @@ def node_parameters(props: dict) -> dict:
 
 
 @functools.lru_cache(maxsize=4)
-def _cached_image(sky_type: str, atmosphere: tuple) -> np.ndarray:
-    compute = single_scattering_image if sky_type == "SINGLE_SCATTERING" else sky_image
-    xyz = compute(*atmosphere)
+def _cached_image(sky_type: str, key: tuple) -> np.ndarray:
+    compute = {"SINGLE_SCATTERING": single_scattering_image,
+               "PREETHAM": preetham_image}.get(sky_type, sky_image)
+    xyz = compute(*key)
     rgba = np.ones(xyz.shape[:2] + (4,), np.float32)
     rgba[..., :3] = xyz
     rgba.setflags(write=False)
@@ -549,7 +654,7 @@ def sky_images(scene: SceneDescription) -> dict:
     for node in nodes:
         name = image_name(node.props)
         if name not in out:
-            out[name] = Image(pixels=_cached_image(_sky_type(node.props), _atmosphere(node.props)),
+            out[name] = Image(pixels=_cached_image(_sky_type(node.props), _image_key(node.props)),
                               colorspace="data", alpha="NONE")
     return out
 

@@ -133,6 +133,11 @@ def _ies_props(node, ctx) -> dict:
             "implicit_vector": 1.0 if source(node.inputs["Vector"])[0] is None else 0.0}
 
 
+def _sky_props(node, ctx) -> dict:
+    """Sky Texture: the Preetham type's Sun Direction (a vector, which the generic copy skips)."""
+    return {"sun_direction": tuple(float(v) for v in node.sun_direction)}
+
+
 def _hair_props(node, ctx) -> dict:
     """Hair BSDF: whether its Tangent is the implicit one (on a mesh Cycles then takes the
     triangle's dPdv and ignores the Offset)."""
@@ -155,6 +160,7 @@ SPECIAL_PROPS = {
     "AmbientOcclusion": _ao_props,
     "TexIES": _ies_props,
     "BsdfHair": _hair_props,
+    "TexSky": _sky_props,
 }
 
 

@@ -4,8 +4,8 @@ The world's shader graph is what the Surface socket of its active Cycles output
 receives, copied by :class:`shader_graph.GraphReader` as a material's is
 (reroutes, muted nodes, groups, every node the core evaluates: Background and
 Emission, Mix and Add Shader, Environment Texture, Sky Texture (Multiple and Single
-Scattering), Light Path, ...).  A graph whose radiance does not vary is rendered as a
-constant colour at no cost per ray.  Unsupported nodes (and the Sky Texture's other types)
+Scattering, Preetham), Light Path, ...).  A graph whose radiance does not vary is rendered as a
+constant colour at no cost per ray.  Unsupported nodes (and the Sky Texture's Hosek / Wilkie type)
 are warned, their consumer keeping its unlinked value.  Nothing linked: black, as in
 Cycles.  A world without a node tree uses ``world.color``; no world at all is black.  Cycles' world settings
 Sampling Method and Map Resolution are copied, and its Ray Visibility (camera, diffuse,

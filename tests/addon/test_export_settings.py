@@ -200,9 +200,10 @@ def test_world_ray_visibility(scene, fake_session):
     assert not [x for x in desc.warnings if "visibility" in x]
 
 
-def test_sky_texture_types_other_than_multiple_scattering_use_the_unlinked_value(scene, fake_session):
-    """The default Sky Texture (Multiple Scattering) is exported with its settings; the other
-    types are named in the warning and their consumer keeps its unlinked value."""
+def test_sky_texture_hosek_wilkie_uses_the_unlinked_value(scene, fake_session):
+    """The default Sky Texture (Multiple Scattering) is exported with its settings, the
+    Preetham type with its Sun Direction; Hosek / Wilkie is named in the warning and its
+    consumer keeps its unlinked value."""
     world = world_with_background((0.1, 0.2, 0.3), 1.0)
     sky = world.node_tree.nodes.new("ShaderNodeTexSky")
     sky.sun_elevation = 0.3
@@ -212,6 +213,12 @@ def test_sky_texture_types_other_than_multiple_scattering_use_the_unlinked_value
     assert len(exported) == 1 and exported[0].props["sun_elevation"] == pytest.approx(0.3)
     assert not [w for w in desc.warnings if w.startswith("world")]
     sky.sky_type = "PREETHAM"
+    sky.sun_direction = (0.6, 0.0, 0.8)
+    desc = export_scene(fake_session)
+    exported = [n for n in desc.world.nodes if n.type == "TexSky"]
+    assert len(exported) == 1 and exported[0].props["sun_direction"] == pytest.approx((0.6, 0.0, 0.8))
+    assert not [w for w in desc.warnings if w.startswith("world")]
+    sky.sky_type = "HOSEK_WILKIE"
     desc = export_scene(fake_session)
     assert not [n for n in desc.world.nodes if n.type == "TexSky"]
     assert [w for w in desc.warnings if w.startswith("world")] == [

@@ -110,6 +110,46 @@ def test_node_parameters_switch_the_disc_off_and_clamp_its_size():
         -math.acos(6371.0 / 6381.0), rel=1e-9)
 
 
+# -- Preetham ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("turbidity", [1.0, 2.2, 10.0])
+@pytest.mark.parametrize("sun_theta", [0.0, 0.7, 1.5])
+def test_preetham_zenith_is_the_fitted_zenith_luminance(turbidity, sun_theta):
+    """Looking straight up, each Perez function equals its normalisation, so Y is Preetham's
+    zenith luminance (in Cycles' scale: x 0.06) and x, y the fitted zenith chromaticities."""
+    t, ts = turbidity, sun_theta
+    chi = (4.0 / 9.0 - t / 120.0) * (math.pi - 2.0 * ts)
+    big_y = ((4.0453 * t - 4.9710) * math.tan(chi) - 0.2155 * t + 2.4192) * 0.06
+    x = (t * t * (0.00166 * ts ** 3 - 0.00375 * ts ** 2 + 0.00209 * ts)
+         + t * (-0.02903 * ts ** 3 + 0.06377 * ts ** 2 - 0.03202 * ts + 0.00394)
+         + 0.11693 * ts ** 3 - 0.21196 * ts ** 2 + 0.06052 * ts + 0.25886)
+    y = (t * t * (0.00275 * ts ** 3 - 0.00610 * ts ** 2 + 0.00317 * ts)
+         + t * (-0.04214 * ts ** 3 + 0.08970 * ts ** 2 - 0.04153 * ts + 0.00516)
+         + 0.15346 * ts ** 3 - 0.26756 * ts ** 2 + 0.06670 * ts + 0.26688)
+    xyz = sky.preetham_xyz(np.array(1.0), np.array(ts), ts, t)
+    assert xyz == pytest.approx([x / y * big_y, big_y, (1.0 - x - y) / y * big_y], rel=1e-12)
+
+
+def test_preetham_image_is_laid_out_about_its_sun():
+    """The image's sun lies between its middle columns (where ``node_parameters`` turns it
+    to the node's normalised Sun Direction), the image is mirrored about it and finite over
+    the node's turbidities, the sun above or below the horizon."""
+    direction = (0.3, -0.4, 0.5)
+    theta, azimuth = sky.preetham_sun(direction)
+    assert theta == pytest.approx(math.acos(0.5 / math.sqrt(0.5)), rel=1e-12)
+    params = sky.node_parameters({"sky_type": "PREETHAM", "sun_direction": direction})
+    assert params["sky_diameter"] == -1.0
+    # The kernel reads column u = (-atan2(y, x) - pi/2 + rotation) / (2 pi): the sun at 1/2.
+    u = (-azimuth - math.pi / 2 + params["sky_rotation"]) / (2.0 * math.pi)
+    assert u - math.floor(u) == pytest.approx(0.5, abs=1e-12)
+    image = sky.preetham_image(theta, 2.2, size=(64, 32))
+    assert np.allclose(image, image[:, ::-1], rtol=1e-12, atol=0.0)
+    assert np.argmax(image[24:, :, 1].max(axis=0)) in (31, 32)
+    mirrored = sky.preetham_image(math.pi - theta, 2.2, size=(64, 32))
+    assert np.all(np.isfinite(image)) and np.all(np.isfinite(mirrored))
+    for turbidity in (1.0, 10.0):
+        assert np.all(np.isfinite(sky.preetham_image(theta, turbidity, size=(64, 32))))
+
+
 # -- the sun disc as a light: sampled through its cone beside the map --------------------------
 SUN_ELEVATION, ALBEDO = 0.6, 0.8
 

@@ -154,6 +154,13 @@ SKY_CASES = {
     "sky texture, single scattering": _sky(
         sky_type="SINGLE_SCATTERING", sun_size=0.3, sun_elevation=0.12,
         sun_rotation=math.radians(30.0), altitude=3000.0, air_density=2.0, aerosol_density=0.5),
+    # Preetham (no disc): a low light at azimuth 124 degrees, elevation 20, in view; a high
+    # one behind the camera in hazy air, not unit length (Blender's sync normalises it).
+    "sky texture, preetham": _sky(sky_type="PREETHAM", sun_direction=(-0.525, 0.779, 0.342)),
+    "sky texture, preetham, hazy, high": _sky(sky_type="PREETHAM", turbidity=7.5,
+                                              sun_direction=(0.3, -0.2, 0.8)),
+    "sky texture, preetham, turned vector": _sky(_turned_direction, sky_type="PREETHAM",
+                                                 turbidity=3.0, sun_direction=(-0.2, 0.9, 0.1)),
 }
 
 CASES = {

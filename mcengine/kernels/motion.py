@@ -32,6 +32,7 @@ from collections import namedtuple
 import numpy as np
 
 from ..jit import builder, device, function, kernel
+from .scalar import safe_acos
 
 SHUTTER_TABLE_SIZE = 256        # Cycles' SHUTTER_TABLE_SIZE
 CURVE_SAMPLES = 257             # Cycles' RAMP_TABLE_SIZE + 1 samples of the shutter curve
@@ -220,7 +221,7 @@ def motion_transform(d, first, steps, time):
         inv = 1.0 / math.sqrt(x * x + y * y + z * z + w * w)
         x, y, z, w = x * inv, y * inv, z * inv, w * inv
     else:
-        theta = math.acos(min(max(cos, -1.0), 1.0))
+        theta = safe_acos(cos)
         px = d[b] - d[a] * cos
         py = d[b + 1] - d[a + 1] * cos
         pz = d[b + 2] - d[a + 2] * cos

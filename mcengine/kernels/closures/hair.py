@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device
+from ..scalar import safe_acos
 from .layout import (
     CL_HAIR_OFFSET,
     CL_HAIR_R1,
@@ -54,11 +55,6 @@ def hair_setup(cl, k, tx, ty, tz, roughness1, roughness2, offset):
     cl[k, CL_HAIR_R1] = min(max(roughness1, 0.001), 1.0)
     cl[k, CL_HAIR_R2] = min(max(roughness2, 0.001), 1.0)
     cl[k, CL_HAIR_OFFSET] = offset
-
-
-@device
-def _acos(x):
-    return math.acos(min(max(x, -1.0), 1.0))
 
 
 @device
@@ -106,8 +102,8 @@ def hair_eval(cl, k, transmission, wox, woy, woz, wix, wiy, wiz):
     oz, yx, yy, yz, ok_i = _split(cl, k, wix, wiy, wiz)
     if not (ok_o and ok_i):
         return 0.0, 0.0, 0.0, 0.0
-    theta_r = _HALF_PI - _acos(iz)
-    theta_i = _HALF_PI - _acos(oz)
+    theta_r = _HALF_PI - safe_acos(iz)
+    theta_i = _HALF_PI - safe_acos(oz)
     cos_phi = yx * lx + yy * ly + yz * lz
     if _HALF_PI - abs(theta_i) < _POLE or (not transmission and cos_phi < 0.0):
         return 0.0, 0.0, 0.0, 0.0
@@ -116,10 +112,10 @@ def hair_eval(cl, k, transmission, wox, woy, woz, wix, wiy, wiz):
     t = (theta_i + theta_r) * 0.5 - offset
     theta_pdf = _theta_pdf(r1, t, a, b, math.cos(theta_i))
     if transmission:
-        p = math.pi - _acos(cos_phi)
+        p = math.pi - safe_acos(cos_phi)
         phi_pdf = r2 / (_c_tt(r2) * (p * p + r2 * r2))
     else:
-        phi = min(_acos(cos_phi) / r2, math.pi)
+        phi = min(safe_acos(cos_phi) / r2, math.pi)
         phi_pdf = math.cos(phi * 0.5) * 0.25 / r2
     pdf = phi_pdf * theta_pdf
     if not (pdf > 0.0 and math.isfinite(pdf)):
@@ -137,7 +133,7 @@ def hair_sample(cl, k, transmission, wox, woy, woz, u1, u2):
     tx, ty, tz = cl[k, CL_HAIR_T], cl[k, CL_HAIR_T + 1], cl[k, CL_HAIR_T + 2]
     # locx = locy x T
     xx, xy, xz = ly * tz - lz * ty, lz * tx - lx * tz, lx * ty - ly * tx
-    theta_r = _HALF_PI - _acos(iz)
+    theta_r = _HALF_PI - safe_acos(iz)
     r1, offset, a, b = _theta(cl, k, theta_r)
     r2 = cl[k, CL_HAIR_R2]
     t = r1 * math.tan(u1 * (a - b) + b)

@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..scalar import saturate
 from .fresnel import (
     F0_from_ior,
     f82_tint_B,
@@ -602,23 +603,16 @@ def microfacet_sample(cl, k, wox, woy, woz, u1, u2, u3):
 
 # -- setup ------------------------------------------------------------------------------------------
 @device
-def _saturate(x):
-    if not x > 0.0:
-        return 0.0
-    return min(x, 1.0)
-
-
-@device
 def microfacet_setup(cl, k):
     """Clamp alpha to [0, 1]; refraction and glass rows become isotropic (alpha_y = alpha_x); CL_ENERGY = 1.
 
     Cycles' bsdf_microfacet_{ggx,beckmann}{,_refraction,_glass}_setup.  Call it after
     filling CL_AX, CL_AY and CL_TYPE, before any of the Fresnel setups below.
     """
-    ax = _saturate(cl[k, CL_AX])
+    ax = saturate(cl[k, CL_AX])
     cl[k, CL_AX] = ax
     if int(cl[k, CL_TYPE]) == CT_MICROFACET:
-        cl[k, CL_AY] = _saturate(cl[k, CL_AY])
+        cl[k, CL_AY] = saturate(cl[k, CL_AY])
     else:
         cl[k, CL_AY] = ax
     cl[k, CL_ENERGY] = 1.0
@@ -809,7 +803,7 @@ def microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy):
     s = 2 / ((e + 3) e + 2) (the integral of 2 cos (1 - cos)^e) otherwise.
     """
     for c in range(3):
-        cl[k, CL_F0 + c] = _saturate(cl[k, CL_F0 + c])
+        cl[k, CL_F0 + c] = saturate(cl[k, CL_F0 + c])
     cl[k, CL_FRESNEL] = FR_SCHLICK
     microfacet_setup_sample_weight(cl, k, cos_no)
     if not preserve_energy:
@@ -819,7 +813,7 @@ def microfacet_setup_fresnel_schlick(cl, k, cos_no, preserve_energy):
         if e < 0.0:
             eta = cl[k, CL_ETA]
             f0 = F0_from_ior(eta)
-            s = _saturate((fresnel_dielectric_Fss(eta) - f0) / (1.0 - f0))
+            s = saturate((fresnel_dielectric_Fss(eta) - f0) / (1.0 - f0))
         else:
             s = 2.0 / ((e + 3.0) * e + 2.0)
         fr = cl[k, CL_RTINT] * (cl[k, CL_F0] + (cl[k, CL_F90] - cl[k, CL_F0]) * s)

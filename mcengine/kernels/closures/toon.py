@@ -18,6 +18,7 @@ import math
 
 from ...jit import device
 from ..sampling import around, uniform_cone, uniform_cone_pdf
+from ..scalar import safe_acos
 from .layout import CL_P0, CL_P1, LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_NONE, LABEL_REFLECT
 
 _HALF_PI = 0.5 * math.pi
@@ -102,5 +103,5 @@ def glossy_toon_sample(cl, k, wox, woy, woz, u1, u2, u3):
     if not wz > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     pdf = uniform_cone_pdf(omc)
-    f = pdf * _intensity(max_angle, smooth, math.acos(min(max(z, -1.0), 1.0)))
+    f = pdf * _intensity(max_angle, smooth, safe_acos(z))
     return wx, wy, wz, f, f, f, pdf, LABEL_GLOSSY | LABEL_REFLECT

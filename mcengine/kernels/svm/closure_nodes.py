@@ -84,6 +84,7 @@ from ..closures.sheen import sheen_setup
 from ..closures.thin_film import THIN_FILM_CUTOFF
 from ..closures.toon import toon_setup
 from ..sampling import orthonormal_basis
+from ..scalar import saturate
 from ..state import PF_DIFFUSE_ANCESTOR
 from .math_nodes import rotate_around_axis
 from .nodes import (
@@ -199,12 +200,6 @@ from .nodes import (
     TL_NORMAL,
     TOON_GLOSSY,
 )
-
-
-@device
-def sat(x):
-    """Clamp to [0, 1] (Cycles' saturatef)."""
-    return min(max(x, 0.0), 1.0)
 
 
 # -- allocation and frames ------------------------------------------------------------------------
@@ -371,7 +366,7 @@ def _attenuate(ar, ag, ab, wr, wg, wb):
         m = max(m, ag / wg)
     if wb != 0.0:
         m = max(m, ab / wb)
-    f = sat(1.0 - m)
+    f = saturate(1.0 - m)
     return wr * f, wg * f, wb * f
 
 
@@ -398,7 +393,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         if k >= 0:
             nx, ny, nz = input_normal(regs, b + D_NORMAL, sd)
             diffuse(cl, k, sd, nx, ny, nz, regs[b + D_ROUGHNESS],
-                    sat(regs[b + COLOR_IN]), sat(regs[b + COLOR_IN + 1]), sat(regs[b + COLOR_IN + 2]))
+                    saturate(regs[b + COLOR_IN]), saturate(regs[b + COLOR_IN + 1]), saturate(regs[b + COLOR_IN + 2]))
     elif kind == K_TRANSLUCENT:
         k, n = alloc(cl, n, cr, cg, cb, sd)
         if k >= 0:
@@ -413,9 +408,9 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
             if regs[b + S_DISTRIBUTION] == DIST_ASHIKHMIN:
                 cl[k, CL_TYPE] = CT_VELVET
                 set_frame(cl, k, nx, ny, nz, 0.0, 0.0, 0.0)
-                cl[k, CL_VELVET_INV_SIGMA2] = 1.0 / max(sat(regs[b + S_ROUGHNESS]), 0.01) ** 2
+                cl[k, CL_VELVET_INV_SIGMA2] = 1.0 / max(saturate(regs[b + S_ROUGHNESS]), 0.01) ** 2
             else:
-                sheen(cl, k, sd, nx, ny, nz, sat(regs[b + S_ROUGHNESS]))
+                sheen(cl, k, sd, nx, ny, nz, saturate(regs[b + S_ROUGHNESS]))
     elif kind == K_TOON:
         glossy_lobe = regs[b + T_COMPONENT] == TOON_GLOSSY
         if sd.reflective_caustics or not glossy_lobe:
@@ -459,7 +454,7 @@ def eval_closure_node(kind, regs, b, w, cl, n, sd):
         n = bssrdf(cl, n, sd, cr, cg, cb, regs[b + SS_RADIUS] * scale,
                    regs[b + SS_RADIUS + 1] * scale, regs[b + SS_RADIUS + 2] * scale,
                    regs[b + COLOR_IN], regs[b + COLOR_IN + 1], regs[b + COLOR_IN + 2],
-                   nx, ny, nz, sat(regs[b + SS_ROUGHNESS]),
+                   nx, ny, nz, saturate(regs[b + SS_ROUGHNESS]),
                    regs[b + SS_IOR], regs[b + SS_ANISOTROPY], regs[b + SS_FALLOFF])
     elif kind == K_GLOSSY:
         if sd.reflective_caustics:
@@ -590,7 +585,7 @@ def glossy(regs, b, cl, n, sd, cr, cg, cb):
         return n
     nx, ny, nz = input_normal(regs, b + G_NORMAL, sd)
     nx, ny, nz = ensure_valid_reflection(sd, nx, ny, nz)
-    a = sat(regs[b + G_ROUGHNESS]) ** 2
+    a = saturate(regs[b + G_ROUGHNESS]) ** 2
     aniso = min(max(regs[b + G_ANISOTROPY], -0.99), 0.99)
     tx, ty, tz = regs[b + G_TANGENT], regs[b + G_TANGENT + 1], regs[b + G_TANGENT + 2]
     ax = ay = a
@@ -629,8 +624,8 @@ def metallic(regs, b, w, cl, n, sd):
         return n
     inx, iny, inz = input_normal(regs, b + M_NORMAL, sd)
     nx, ny, nz = ensure_valid_reflection(sd, inx, iny, inz)
-    a = sat(regs[b + M_ROUGHNESS]) ** 2
-    aniso = sat(regs[b + M_ANISOTROPY])
+    a = saturate(regs[b + M_ROUGHNESS]) ** 2
+    aniso = saturate(regs[b + M_ANISOTROPY])
     tx, ty, tz = regs[b + M_TANGENT], regs[b + M_TANGENT + 1], regs[b + M_TANGENT + 2]
     ax = ay = a
     if aniso > 0.0 and (tx != 0.0 or ty != 0.0 or tz != 0.0):
@@ -653,9 +648,9 @@ def metallic(regs, b, w, cl, n, sd):
         microfacet_setup_fresnel_conductor(cl, k, cos_no, multiscatter)
     else:
         for c in range(3):
-            cl[k, CL_F0 + c] = sat(regs[b + M_BASE_COLOR + c])
-        microfacet_setup_fresnel_f82_tint(cl, k, cos_no, sat(regs[b + M_EDGE_TINT]),
-                                          sat(regs[b + M_EDGE_TINT + 1]), sat(regs[b + M_EDGE_TINT + 2]),
+            cl[k, CL_F0 + c] = saturate(regs[b + M_BASE_COLOR + c])
+        microfacet_setup_fresnel_f82_tint(cl, k, cos_no, saturate(regs[b + M_EDGE_TINT]),
+                                          saturate(regs[b + M_EDGE_TINT + 1]), saturate(regs[b + M_EDGE_TINT + 2]),
                                           multiscatter)
     return n
 
@@ -673,7 +668,7 @@ def glass(regs, b, w, cl, n, sd):
     nx, ny, nz = input_normal(regs, b + GL_NORMAL, sd)
     nx, ny, nz = ensure_valid_reflection(sd, nx, ny, nz)
     ior = max(regs[b + GL_IOR], 1e-5)
-    a = sat(regs[b + GL_ROUGHNESS]) ** 2
+    a = saturate(regs[b + GL_ROUGHNESS]) ** 2
     dist = regs[b + GL_DISTRIBUTION]
     cos_no = microfacet(cl, k, CT_MICROFACET_GLASS, dist, a, a, 1.0 / ior if sd.backfacing else ior,
                         nx, ny, nz, 0.0, 0.0, 0.0, sd)
@@ -695,9 +690,9 @@ def principled(regs, b, mix_weight, cl, n, sd):
     base_b = max(regs[b + P_BASE_COLOR + 2], 0.0)
     cbase_r, cbase_g, cbase_b = min(base_r, 1.0), min(base_g, 1.0), min(base_b, 1.0)
     ior = max(regs[b + P_IOR], 1e-5)
-    roughness = sat(regs[b + P_ROUGHNESS])
-    metallic = sat(regs[b + P_METALLIC])
-    alpha = sat(regs[b + P_ALPHA])
+    roughness = saturate(regs[b + P_ROUGHNESS])
+    metallic = saturate(regs[b + P_METALLIC])
+    alpha = saturate(regs[b + P_ALPHA])
     nx, ny, nz = input_normal(regs, b + P_NORMAL, sd)
     rnx, rny, rnz = ensure_valid_reflection(sd, nx, ny, nz)
     cx, cy, cz = regs[b + P_COAT_NORMAL], regs[b + P_COAT_NORMAL + 1], regs[b + P_COAT_NORMAL + 2]
@@ -708,7 +703,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
         cnx, cny, cnz = nx, ny, nz
     dist = regs[b + P_DISTRIBUTION]
     multiscatter = dist == DIST_MULTI_GGX
-    diffuse_roughness = sat(regs[b + P_DIFFUSE_ROUGHNESS])
+    diffuse_roughness = saturate(regs[b + P_DIFFUSE_ROUGHNESS])
     specular_level = max(regs[b + P_SPECULAR_LEVEL], 0.0)
     st_r = max(regs[b + P_SPECULAR_TINT], 0.0)
     st_g = max(regs[b + P_SPECULAR_TINT + 1], 0.0)
@@ -716,13 +711,13 @@ def principled(regs, b, mix_weight, cl, n, sd):
     es = regs[b + P_EMISSION_STRENGTH]
     em_r, em_g, em_b = (regs[b + P_EMISSION_COLOR] * es, regs[b + P_EMISSION_COLOR + 1] * es,
                         regs[b + P_EMISSION_COLOR + 2] * es)
-    anisotropic = sat(regs[b + P_ANISOTROPIC])
+    anisotropic = saturate(regs[b + P_ANISOTROPIC])
     thin_film = regs[b + P_THIN_FILM]
     film_ior = max(regs[b + P_THIN_FILM_IOR], 1e-5) if thin_film > THIN_FILM_CUTOFF else 0.0
-    subsurface = sat(regs[b + P_SUBSURFACE_WEIGHT])
+    subsurface = saturate(regs[b + P_SUBSURFACE_WEIGHT])
     coat_weight = max(regs[b + P_COAT_WEIGHT], 0.0)
     sheen_weight = max(regs[b + P_SHEEN_WEIGHT], 0.0)
-    transmission = sat(regs[b + P_TRANSMISSION])
+    transmission = saturate(regs[b + P_TRANSMISSION])
     wr = wg = wb = mix_weight
     tr = tg = tb = 0.0
     refl, refr = sd.reflective_caustics, sd.refractive_caustics
@@ -753,12 +748,12 @@ def principled(regs, b, mix_weight, cl, n, sd):
                      sw * max(regs[b + P_SHEEN_TINT + 1], 0.0) * wg,
                      sw * max(regs[b + P_SHEEN_TINT + 2], 0.0) * wb, sd)
         if k >= 0:
-            f = sat(coat_weight)
+            f = saturate(coat_weight)
             sx, sy, sz = nx + (cnx - nx) * f, ny + (cny - ny) * f, nz + (cnz - nz) * f
             slen = math.sqrt(sx * sx + sy * sy + sz * sz)
             if slen > 0.0:
                 sx, sy, sz = sx / slen, sy / slen, sz / slen
-            if sheen(cl, k, sd, sx, sy, sz, sat(regs[b + P_SHEEN_ROUGHNESS])):
+            if sheen(cl, k, sd, sx, sy, sz, saturate(regs[b + P_SHEEN_ROUGHNESS])):
                 wr, wg, wb = _attenuate(cl[k, CL_W], cl[k, CL_W + 1], cl[k, CL_W + 2], wr, wg, wb)
 
     # Coat layer and its tint.
@@ -768,7 +763,7 @@ def principled(regs, b, mix_weight, cl, n, sd):
         if refl:
             k, n = alloc(cl, n, coat_weight * wr, coat_weight * wg, coat_weight * wb, sd)
             if k >= 0:
-                ca = sat(regs[b + P_COAT_ROUGHNESS]) ** 2
+                ca = saturate(regs[b + P_COAT_ROUGHNESS]) ** 2
                 cos_no = microfacet(cl, k, CT_MICROFACET, 0.0, ca, ca, coat_ior, vcx, vcy, vcz,
                                     0.0, 0.0, 0.0, sd)
                 microfacet_setup_fresnel_dielectric(cl, k, cos_no)

@@ -15,6 +15,7 @@ import math
 
 from ...jit import device, function
 from ..colorspace import hsv_to_rgb, rgb_to_hsv
+from ..scalar import saturate
 from .nodes import (
     DATA_FLOAT,
     DATA_VECTOR,
@@ -149,14 +150,6 @@ def eval_color_node(code, regs, b, c):
             elif x > 0.0:
                 x = x ** gamma
             regs[c + k] = x
-
-
-@device
-def saturate(x):
-    """x clamped to [0, 1]; NaN gives 0 (Cycles' clamp of comparisons)."""
-    if x > 1.0:
-        return 1.0
-    return x if x > 0.0 else 0.0
 
 
 @device

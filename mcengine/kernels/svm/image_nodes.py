@@ -25,6 +25,7 @@ import math
 
 from ...jit import device, function
 from ..colorspace import XYZ_TO_RGB
+from ..scalar import safe_acos
 from .data import (
     IMG_CHANNELS,
     IMG_FLAGS,
@@ -235,7 +236,7 @@ def map_to_sphere(x, y, z):
     if ln <= 0.0:
         return 0.0, 0.0
     u = 0.0 if (x == 0.0 and y == 0.0) else 0.5 - math.atan2(x, y) / (2.0 * math.pi)
-    return u, 1.0 - math.acos(min(max(z / ln, -1.0), 1.0)) / math.pi
+    return u, 1.0 - safe_acos(z / ln) / math.pi
 
 
 @device
@@ -337,7 +338,7 @@ def direction_to_equirectangular(x, y, z):
     if ln <= 0.0:
         return 0.0, 0.0
     u = (math.atan2(y, x) - math.pi) / (-2.0 * math.pi)
-    v = (math.acos(min(max(z / ln, -1.0), 1.0)) - math.pi) / (-math.pi)
+    v = (safe_acos(z / ln) - math.pi) / (-math.pi)
     return u, v
 
 
@@ -383,7 +384,7 @@ def sky_texture_node(regs, b, c, tex):
     ln = math.sqrt(x * x + y * y + z * z)
     if ln > 0.0:
         x, y, z = x / ln, y / ln, z / ln
-    elevation = math.pi / 2 - math.acos(min(max(z, -1.0), 1.0))
+    elevation = math.pi / 2 - safe_acos(z)
     sun_elevation, rotation = regs[b + _TS_ELEVATION], regs[b + _TS_ROTATION]
     diameter = regs[b + _TS_DIAMETER]
     cx = cy = cz = 0.0

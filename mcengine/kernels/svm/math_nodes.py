@@ -18,6 +18,7 @@ import numpy as np
 
 from ...jit import device, function
 from ..colorspace import blackbody, hsl_to_rgb, hsv_to_rgb, luminance, rgb_to_hsl, rgb_to_hsv, wavelength
+from ..scalar import safe_acos
 from .nodes import (
     CLAMP_TYPES,
     COLOR_MODES,
@@ -284,7 +285,7 @@ def math_op(op, a, b, c):
     if op == OP_ARCSINE:
         return math.asin(min(max(a, -1.0), 1.0))
     if op == OP_ARCCOSINE:
-        return math.acos(min(max(a, -1.0), 1.0))
+        return safe_acos(a)
     if op == OP_ARCTANGENT:
         return math.atan(a)
     if op == OP_ARCTAN2:

@@ -59,6 +59,7 @@ SCENES = (
     "material_thin_film",
     "holdout_objects",
     "world_sky",
+    "world_sky_preetham",
     "material_displacement",
     "material_subsurface",
     "ray_visibility",

@@ -50,8 +50,9 @@ def test_scenes_exist():
             "holdout_objects", "material_displacement",
             # random-walk subsurface scattering; objects' ray visibility; light linking
             "material_subsurface", "ray_visibility", "light_linking",
-            # IES light profiles; the Toon, Hair and Ray Portal BSDFs
-            "light_ies", "material_toon", "material_hair", "material_ray_portal"} <= names
+            # IES light profiles; the Toon, Hair and Ray Portal BSDFs; the Preetham sky
+            "light_ies", "material_toon", "material_hair", "material_ray_portal",
+            "world_sky_preetham"} <= names
 
 
 @pytest.mark.parametrize("blend", SCENES, ids=lambda p: p.stem)

@@ -194,6 +194,12 @@ def test_world_agrees_with_cycles(images, name):
     assert ref.std() > 0.01        # the world varies over the frame
     # The sky image: measured within 9e-5 of Cycles in the median pixel, 9.5e-4 in the 97th
     # percentile, 3.9e-3 at most (next to the horizon, where it changes fastest).
+    # Preetham (Cycles evaluates it per ray, MC Engine reads a 1024 x 512 image; no disc, no
+    # edge): 4e-6 in the median pixel, 2.3e-4 at worst, in every pixel (a 512 x 256 image,
+    # 1.1e-3 at worst, fails).
+    if "preetham" in name:
+        assert_agree(name, ref, ours, rel=5e-4, edge_fraction=0.0)
+        return
     rel = 2e-3 if name in SKY_CASES else 1e-3
     assert_agree(name, ref, ours, rel=rel, edge_fraction=0.03)
 

@@ -5,8 +5,8 @@
   keys its cache on the file of each function only (and not on the jit
   options), so a kernel would keep the stale code of a helper it inlined
   from another file; the cache therefore lives in a folder named after a
-  hash of every source that compiled code comes from (this file, the
-  ``kernels`` package and its data tables, which numba freezes into the
+  hash of every source that compiled code comes from (this file,
+  ``numba_patches``, the ``kernels`` package and its data tables, which numba freezes into the
   code: ``__pycache__/numba-<hash>`` next to them, or
   ``~/.cache/mcengine`` if that is not writable; ``NUMBA_CACHE_DIR`` still
   wins).
@@ -20,7 +20,8 @@
   call numba does not inline costs 15-40 ns (its calling convention passes
   every array as a struct and checks an error status), which summed over the
   dozen helpers of a shading step made it several times slower.  Kernels
-  compile more slowly; the cache keeps that a one-off.
+  compile more slowly; the cache keeps that a one-off, and ``numba_patches``
+  makes three of numba's compile steps faster on such large functions.
 * ``builder``: host-side code that builds and returns arrays once per render
   (the motion-blur BVH); it keeps numba's reference counting.
 * ``function``: the few large steps (running a shader, evaluating or
@@ -33,7 +34,6 @@
   kernels never allocate or return arrays; the caller's references keep
   every array they touch alive.
 """
-import copy
 import hashlib
 import os
 import shutil
@@ -41,6 +41,8 @@ from pathlib import Path
 
 from numba import njit
 from numba.core import config
+
+from . import numba_patches
 
 
 def _cache_dir() -> str | None:
@@ -50,7 +52,7 @@ def _cache_dir() -> str | None:
     digest = hashlib.sha256()
     kernels = here / "kernels"
     sources = sorted([*kernels.rglob("*.py"), *kernels.rglob("*.npy")])
-    for source in [Path(__file__).resolve(), *sources]:
+    for source in [Path(__file__).resolve(), here / "numba_patches.py", *sources]:
         digest.update(str(source.relative_to(here)).encode())
         digest.update(source.read_bytes())
     base = here / "__pycache__"
@@ -98,67 +100,7 @@ def _cached(decorator):
     return apply
 
 
-def _speed_up_inlining() -> None:
-    """Two changes to how numba inlines ``inline="always"`` functions: the compiled code is
-    the same, a cold compile of the path tracer took 529 s instead of 898 s
-    (``benchmarks/compile_times.py``), of every integrator 724 s instead of 1143 s.  Left
-    alone if this numba lays inlining out otherwise.
-
-    * numba copies the callee's IR before splicing it in with one ``copy.deepcopy`` per
-      block, and each block refers to the function's scope, which holds every variable:
-      so every block copied the whole variable table again, work that grows as blocks times
-      variables in the large inlined functions.  The blocks of one IR now share one copy
-      of their scope, as they shared the scope they were copied from.
-    * for every call site numba also prepared the callee's IR from its bytecode again,
-      inlining the callee's own callees again, and so on down the call tree.  The IR it
-      prepares is only ever copied, so it is kept and handed out again, under a fresh
-      function identity, from which numba names the inlined variables as a fresh run would.
-    """
-    try:
-        from numba.core import bytecode, ir
-        from numba.core import inline_closurecall as inlining
-    except ImportError:         # pragma: no cover - another numba layout
-        return
-    worker = getattr(inlining, "InlineWorker", None)
-    original = getattr(worker, "run_untyped_passes", None)
-    if original is None or getattr(inlining, "copy", None) is not copy:
-        return
-
-    class BlockCopier:
-        """``copy`` as ``inline_closurecall`` sees it: blocks of one scope share its copy."""
-
-        def __init__(self):
-            self.last = None      # (scope, its copy, their numbers of variables)
-
-        def deepcopy(self, x, memo=None):
-            if memo is not None or not isinstance(x, ir.Block):
-                return copy.deepcopy(x, memo)
-            scope, last = x.scope, self.last
-            if last is None or last[0] is not scope or \
-                    (len(scope.localvars._con), len(last[1].localvars._con)) != last[2]:
-                shared = copy.deepcopy(scope)
-                last = self.last = (scope, shared,
-                                    (len(scope.localvars._con), len(shared.localvars._con)))
-            return copy.deepcopy(x, {id(scope): last[1]})
-
-    prepared = {}
-
-    def run_untyped_passes(self, func, enable_ssa=False):
-        key = (func, enable_ssa)
-        if key not in prepared:
-            prepared[key] = original(self, func, enable_ssa)
-        else:
-            self.flags.enable_ssa = enable_ssa     # as the pipeline run sets it
-        func_ir = prepared[key].copy()
-        func_ir.func_id = bytecode.FunctionIdentity.from_function(func)
-        return func_ir
-
-    run_untyped_passes.__wrapped__ = original
-    inlining.copy = BlockCopier()
-    worker.run_untyped_passes = run_untyped_passes
-
-
-_speed_up_inlining()
+numba_patches.apply()
 
 device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=False))
 # Host-side builders that allocate their results (acceleration structures), run once per render.

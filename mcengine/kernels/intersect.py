@@ -37,6 +37,7 @@ import numpy as np
 from ..jit import device, kernel
 from . import embree
 from .motion import moving_closest, moving_normals, moving_occluded, moving_triangle
+from .scalar import saturate
 from .state import (
     PF_CAMERA,
     PF_DIFFUSE,
@@ -235,8 +236,8 @@ def intersect_triangle(ox, oy, oz, dx, dy, dz, v0x, v0y, v0z, v1x, v1y, v1z, v2x
         return t, 1.0 / 3.0, 1.0 / 3.0
     b1 = (d11 * d20 - d01 * d21) / g
     b2 = (d00 * d21 - d01 * d20) / g
-    b1 = min(max(b1, 0.0), 1.0)
-    b2 = min(max(b2, 0.0), 1.0)
+    b1 = saturate(b1)
+    b2 = saturate(b2)
     s = b1 + b2
     if s > 1.0:
         b1 /= s

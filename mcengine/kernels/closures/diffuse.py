@@ -19,6 +19,7 @@ import math
 
 from ...jit import device
 from ..sampling import cosine_hemisphere
+from ..scalar import safe_acos
 from .layout import (
     CL_P0,
     CL_P1,
@@ -82,7 +83,7 @@ def oren_nayar_G(cos_t):
     if cos_t < 1e-6:
         return (0.5 * math.pi - 2.0 / 3.0) - cos_t
     sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))
-    theta = math.acos(min(cos_t, 1.0))
+    theta = safe_acos(cos_t)
     return sin_t * (theta - 2.0 / 3.0 - sin_t * cos_t) + (2.0 / 3.0) * (sin_t / cos_t) * (1.0 - sin_t * sin_t * sin_t)
 
 

@@ -18,7 +18,7 @@ import math
 
 from ...jit import device
 from ..sampling import around, uniform_cone, uniform_cone_pdf
-from ..scalar import safe_acos
+from ..scalar import safe_acos, saturate
 from .layout import CL_P0, CL_P1, LABEL_DIFFUSE, LABEL_GLOSSY, LABEL_NONE, LABEL_REFLECT
 
 _HALF_PI = 0.5 * math.pi
@@ -52,7 +52,7 @@ def _cone(cl, k):
 def _lobe(cl, k, cos_axis):
     """(f cos, pdf) of a direction at cosine ``cos_axis`` from the lobe's axis."""
     max_angle, smooth, omc = _cone(cl, k)
-    angle = math.acos(min(max(cos_axis, 0.0), 1.0))
+    angle = math.acos(saturate(cos_axis))
     if not angle < min(max_angle + smooth, _HALF_PI):
         return 0.0, 0.0
     pdf = uniform_cone_pdf(omc)
@@ -76,7 +76,7 @@ def diffuse_toon_sample(cl, k, wox, woy, woz, u1, u2, u3):
     if not z > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, LABEL_NONE
     pdf = uniform_cone_pdf(omc)
-    f = pdf * _intensity(max_angle, smooth, math.acos(min(z, 1.0)))
+    f = pdf * _intensity(max_angle, smooth, safe_acos(z))
     return x, y, z, f, f, f, pdf, LABEL_REFLECT | LABEL_DIFFUSE
 
 

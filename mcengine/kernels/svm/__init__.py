@@ -46,6 +46,7 @@ import numpy as np
 
 from ...jit import device, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
+from ..scalar import saturate
 from .ao import ao_node
 from .bevel import bevel_node
 from .bump import bump_point, dpdv_node, undisplaced_point, with_normal
@@ -239,7 +240,7 @@ def closure_row(ops, pc, regs, cl, sd, res):
     returns the :class:`ShaderResult` with this row's closures and light added."""
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if ops[pc, 0] == OP_MIX_WEIGHT:
-        fac = min(max(regs[a], 0.0), 1.0)
+        fac = saturate(regs[a])
         w = regs[b] if b >= 0 else 1.0
         regs[c] = w * (1.0 - fac)
         regs[c + 1] = w * fac

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..scalar import saturate
 from .hash import float_bits, hash_bits3, hash_bits4
 from .nodes import OFFSETS, OUTPUT_OFFSETS
 
@@ -140,7 +141,7 @@ def gabor_node(regs, b, c):
     """Inputs at regs[b:] (nodes.VALUE_NODES), Value, Phase and Intensity to regs[c:]."""
     scale = regs[b + _GB_SCALE]
     x, y, z = regs[b] * scale, regs[b + 1] * scale, regs[b + 2] * scale
-    isotropy = 1.0 - min(max(regs[b + _GB_ANISOTROPY], 0.0), 1.0)
+    isotropy = 1.0 - saturate(regs[b + _GB_ANISOTROPY])
     frequency = max(0.001, regs[b + _GB_FREQUENCY])
     if int(regs[b + _GB_TYPE]) == GABOR_3D:
         ox, oy, oz = (regs[b + _GB_ORIENTATION_3D], regs[b + _GB_ORIENTATION_3D + 1],

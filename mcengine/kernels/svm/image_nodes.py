@@ -25,7 +25,7 @@ import math
 
 from ...jit import device, function
 from ..colorspace import XYZ_TO_RGB
-from ..scalar import safe_acos
+from ..scalar import safe_acos, saturate
 from .data import (
     IMG_CHANNELS,
     IMG_FLAGS,
@@ -267,7 +267,7 @@ def box_weights(nx, ny, nz, blend):
     elif blend > 0.0:
         half = 0.5 * (1.0 - blend)
         if nz < (1.0 - limit) * (ny + nx):
-            wx = min(max((nx / (nx + ny) - half) / blend, 0.0), 1.0)
+            wx = saturate((nx / (nx + ny) - half) / blend)
             wy = 1.0 - wx
         elif nx < (1.0 - limit) * (ny + nz):
             wy = min(max((ny / (ny + nz) - half) / blend, 0.0), 1.0)

@@ -14,6 +14,7 @@ import math
 
 from ...jit import device, function
 from ..ies import ies_direction
+from ..scalar import saturate
 from .gabor import gabor_node
 from .hash import hash_float, hash_float2, hash_float3, hash_float4, r32
 from .input_nodes import normal_to_object
@@ -233,7 +234,7 @@ def gradient_node(regs, b, c):
     elif kind == 1:                    # quadratic
         f = max(x, 0.0) ** 2
     elif kind == 2:                    # easing
-        r = min(max(x, 0.0), 1.0)
+        r = saturate(x)
         f = 3.0 * r * r - 2.0 * r * r * r
     elif kind == 3:                    # diagonal
         f = (x + y) * 0.5
@@ -242,7 +243,7 @@ def gradient_node(regs, b, c):
     else:                              # quadratic sphere, spherical
         r = max(0.999999 - math.sqrt(x * x + y * y + z * z), 0.0)
         f = r * r if kind == 5 else r
-    f = min(max(f, 0.0), 1.0)
+    f = saturate(f)
     regs[c], regs[c + 1], regs[c + 2] = f, f, f
     regs[c + 3] = f
 
@@ -316,7 +317,7 @@ def brick_node(regs, b, c):
     x = (px + offset) - width * brick
     y = py - height * row
     tint = _brick_noise(((row << 16) + (brick & 0xFFFF)) & 0xFFFFFFFF) + regs[b + _BR_BIAS]
-    tint = min(max(tint, 0.0), 1.0)
+    tint = saturate(tint)
     dist = min(min(x, y), min(width - x, height - y))
     if dist >= mortar_size:
         f = 0.0

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 from ...jit import device, function
+from ..scalar import saturate
 from .hash import hash_float, hash_float2, pcg2, pcg3, pcg4
 from .math_nodes import FLT_MAX
 from .nodes import CHEBYCHEV, EUCLIDEAN, MANHATTAN, MINKOWSKI
@@ -247,8 +248,8 @@ def voronoi_texture(dim, feature, metric, x, y, z, w, scale, detail, roughness, 
                     smoothness, exponent, randomness, normalize):
     """The Voronoi node at the scaled point: (distance, r, g, b, px, py, pz, pw, radius)."""
     detail = min(max(detail, 0.0), 15.0)
-    roughness = min(max(roughness, 0.0), 1.0)
-    rnd = min(max(randomness, 0.0), 1.0)
+    roughness = saturate(roughness)
+    rnd = saturate(randomness)
     smooth = min(max(smoothness / 2.0, 0.0), 0.5)
     if feature == N_SPHERE_RADIUS:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, voronoi_n_sphere_radius(dim, rnd, x, y, z, w)

@@ -15,8 +15,11 @@ the scene uses), and one of a scene with what else a render may compile
 displacement),
 then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core:
 once the shader evaluator, which every integrator calls, is in the cache, a second
-process (``python -m mcengine.warmup --only NAME...``) compiles the other
-integrators while this one compiles the default integrator and the features.
+process (``python -m mcengine.warmup --only NAME... [--then NAME...]``) compiles the other
+integrators while this one compiles the default integrator and the features.  The
+integrators that trace light paths beside camera paths run the default integrator's
+kernels too, so the second process renders them (``--then``) once this one has put those
+in the cache, rather than compiling the same kernels beside it.
 Compiling every integrator here matters beyond the wait: numba compiling inside a
 Blender process where Cycles has rendered can crash that process (seen with bpy
 5.0.1: a segfault in the next render), so a user's first Whitted render after a
@@ -24,6 +27,7 @@ Cycles one must find its kernels compiled.
 """
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -145,6 +149,22 @@ def _compile(steps) -> None:
         _marker(step).touch()
 
 
+def _runs_default(integrator: str) -> bool:
+    """Whether ``integrator`` also runs the default integrator's kernels (light tracing
+    traces the camera paths with the path tracer's)."""
+    return integrator != integrators.DEFAULT and integrators.get(integrator).light_tracing
+
+
+def _wait_for_default(poll: float = 0.5) -> None:
+    """Until the default integrator's kernels are compiled by the process that started this
+    one (which ends this one if it stops first; if it is killed, this one ends too)."""
+    parent = os.getppid()
+    while not _marker(integrators.DEFAULT).exists():
+        if os.getppid() != parent:
+            raise SystemExit("mcengine.warmup: the compile that started this one has ended")
+        time.sleep(poll)
+
+
 def compile_kernels() -> float:
     """Compile (or load) every integrator's kernels, the default one first, and the
     features'; seconds taken.
@@ -156,10 +176,13 @@ def compile_kernels() -> float:
     from .packing import pack_scene
     start = time.perf_counter()
     others = sorted(set(integrators.NAMES) - {integrators.DEFAULT})
+    first = [name for name in others if not _runs_default(name)]
+    then = [name for name in others if _runs_default(name)]
     helper = None
     try:
         pack_scene(warm_up_scene())        # compiles the shader evaluator
-        helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *others],
+        helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *first,
+                                   "--then", *then],
                                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
         _compile([integrators.DEFAULT, FEATURES])
         if helper.wait() != 0:
@@ -177,7 +200,12 @@ def main(argv=None) -> int:
     # The add-on ends the background compile with SIGTERM: end the helper process too.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     if args[:1] == ["--only"]:
-        _compile(args[1:])
+        steps = args[1:]
+        cut = steps.index("--then") if "--then" in steps else len(steps)
+        _compile(steps[:cut])
+        if steps[cut + 1:]:
+            _wait_for_default()
+            _compile(steps[cut + 1:])
         return 0
     if jit.cache_is_ready():
         print("mcengine: kernels already compiled")

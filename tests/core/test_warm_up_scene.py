@@ -11,7 +11,7 @@ import pytest
 from mcengine import background, displacement, integrators, packing
 from mcengine.kernels import classic, intersect, light_tracing, motion, path, shadows
 from mcengine.session import RenderSession
-from mcengine.warmup import features_scene, warm_up_scene
+from mcengine.warmup import _runs_default, features_scene, warm_up_scene
 
 
 def _kernels(module) -> list[str]:
@@ -39,6 +39,21 @@ def test_the_warm_up_render_runs_every_kernel_of_the_integrator(name, monkeypatc
     assert len(expected) >= 4
     RenderSession(warm_up_scene(name), threads=1).run()
     assert called == expected, f"not run: {sorted(expected - called)}"
+
+
+@pytest.mark.parametrize("name", sorted(set(integrators.NAMES) - {integrators.DEFAULT}))
+def test_the_second_compile_process_waits_for_the_default_kernels_it_runs(name, monkeypatch):
+    """The warm-up's second process renders an integrator that runs the default one's
+    kernels only once the first has compiled them (``--then``): else both compile them."""
+    assert integrators.DEFAULT == "path"
+    called = []
+    for kernel in _kernels(path):
+        def record(*args, _fn=getattr(path, kernel)):
+            called.append(_fn)
+            return _fn(*args)
+        monkeypatch.setattr(path, kernel, record)
+    RenderSession(warm_up_scene(name), threads=1).run()
+    assert bool(called) == _runs_default(name)
 
 
 def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):

@@ -3,7 +3,7 @@
 The kernels inline most of what they call (``jit.device``), so numba's passes over one
 kernel see thousands of blocks and tens of thousands of variables; three of them took
 time that grows as blocks times variables, and were most of a cold compile
-(``benchmarks/compile_times.py``; the path tracer's ``shade`` alone took 300 s).  Each
+(``benchmarks/compile_times.py``).  Each
 change below computes what numba's own code computes, and is left out if this numba lays
 the code out otherwise (``apply``).  ``tests/core/test_jit.py`` compares each with the
 original, and the machine code of a compiled function with and without them.
@@ -15,7 +15,8 @@ original, and the machine code of a compiled function with and without them.
   copied from.  For every call site numba also prepared the callee's IR from its bytecode
   again, inlining the callee's own callees again, and so on down the call tree; the IR it
   prepares is only ever copied, so it is kept and handed out again, under a fresh function
-  identity, from which numba names the inlined variables as a fresh run would.
+  identity, from which numba names the inlined variables as a fresh run would.  (A cold
+  compile of the path tracer took 898 s before this change, 529 s after.)
 * SSA reconstruction (``ssa._run_ssa``): for each variable assigned more than once numba
   walked every statement of the function twice (renaming its definitions, then its uses).
   Only the blocks that define, respectively use, that variable can change, so only those
@@ -24,7 +25,9 @@ original, and the machine code of a compiled function with and without them.
 * Liveness (``analysis.compute_live_map``, run after most passes): the sets of variables
   that reach and that are live at each block, propagated over the control-flow graph
   until nothing changes, are held as bit sets (Python integers, one bit per variable)
-  while they propagate, rather than as sets of names.
+  while they propagate, rather than as sets of names.  (With the SSA change: every
+  integrator, cold, in one process, 877 s before, 637 s after; ``path.shade`` alone
+  299 s before, 140 s after.)
 """
 from __future__ import annotations
 

@@ -170,9 +170,9 @@ def compile_kernels() -> float:
     features'; seconds taken.
 
     The other integrators are compiled by a second process once this one has put the
-    shader evaluator into the cache; this one compiles the features after the path tracer
-    (about 40 s), and the two end within seconds of each other (a fresh clone's .ci/run at
-    2a2e872: about 8 minutes in all)."""
+    shader evaluator into the cache (about 230 s); this one compiles the features after the
+    path tracer (about 50 s), and the two end within half a minute of each other (a fresh
+    clone's .ci/run at 26dbcbf: about 8 min 10 s in all)."""
     from .packing import pack_scene
     start = time.perf_counter()
     others = sorted(set(integrators.NAMES) - {integrators.DEFAULT})

@@ -597,6 +597,23 @@ NO_TEXTURES = TextureData(attr=np.zeros((0, 3, 2), np.float32), normals=np.zeros
 NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32), no_local_bvh())
 
 
+def compile_node_functions(functions) -> None:
+    """Compile node functions of the shader evaluator (``kernels.svm``'s ``eval_*_node``,
+    which take (code, regs, b, c[, sd, tex])) for the argument types that the evaluator and
+    the folding above give them, without running them: ``mcengine.warmup`` compiles some in
+    a second process while the first compiles the others."""
+    types = node_argument_types()
+    for function in functions:
+        function.compile(types[:function.py_func.__code__.co_argcount])
+
+
+def node_argument_types() -> tuple:
+    """numba's types of (code, regs, b, c, sd, tex) as the folding passes them to a node."""
+    from numba import typeof
+    return tuple(typeof(value) for value in (np.int64(0), np.zeros(1), np.int64(0), np.int64(0),
+                                              _HOST_POINT, NO_TEXTURES))
+
+
 class ShaderTable:
     """Every material's program in one pair of arrays, and what the renderer must know
     of each material before shading it.

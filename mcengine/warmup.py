@@ -13,13 +13,16 @@ It renders a few samples of one pixel of a tiny scene with each integrator
 the scene uses), and one of a scene with what else a render may compile
 (``features_scene``: motion blur, a world and a mesh light whose radiance varies, true
 displacement),
-then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core:
-once the shader evaluator, which every integrator calls, is in the cache, a second
-process (``python -m mcengine.warmup --only NAME... [--then NAME...]``) compiles the other
-integrators while this one compiles the default integrator and the features.  The
-integrators that trace light paths beside camera paths run the default integrator's
-kernels too, so the second process renders them (``--then``) once this one has put those
-in the cache, rather than compiling the same kernels beside it.
+then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core, so a
+second process (``python -m mcengine.warmup --steps STEP...``) shares the work: while this
+one compiles the procedural textures' node function, it compiles the input, math, colour
+and image nodes' (the shader evaluator's first callees, which this one then finds in the
+cache); once this one has compiled the rest of the evaluator, which every integrator calls,
+the second compiles the other integrators while this one compiles the default integrator
+and the features.  The integrators that trace light paths beside camera paths run the
+default integrator's kernels too, so the second process renders them once this one has put
+those in the cache.  A step ``wait:NAME`` waits for step NAME of this process; otherwise
+each process would compile what the other is compiling.
 Compiling every integrator here matters beyond the wait: numba compiling inside a
 Blender process where Cycles has rendered can crash that process (seen with bpy
 5.0.1: a segfault in the next render), so a user's first Whitted render after a
@@ -56,6 +59,10 @@ from .scene import (
 __all__ = ["warm_up_scene", "features_scene", "compile_kernels", "is_compiled", "main"]
 
 FEATURES = "features"      # the warm-up step that renders ``features_scene``
+EVALUATOR = "evaluator"    # the step that compiles the shader evaluator (packing a scene)
+TEXTURE_NODES = "texture-nodes"    # steps that compile node functions alone
+OTHER_NODES = "other-nodes"
+WAIT = "wait:"             # a step that waits for the named step's marker
 # The floor of both scenes: a 2 m square at z = 0 facing up, two triangles.
 _FLOOR = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]],
                   np.float64)
@@ -141,12 +148,33 @@ def _displaced_material() -> Material:
 
 
 def _compile(steps) -> None:
-    """Render each step's scene: an integrator's ``warm_up_scene``, or ``features_scene``."""
+    """Run each step: render an integrator's ``warm_up_scene`` or ``features_scene``, compile
+    the shader evaluator or some of its node functions, or wait (``WAIT``)."""
+    from .packing import pack_scene
     from .session import RenderSession
+    from .shaders import compile_node_functions
     for step in steps:
-        scene = features_scene() if step == FEATURES else warm_up_scene(step)
-        RenderSession(scene, threads=1).run()
+        if step.startswith(WAIT):
+            _wait_for(step[len(WAIT):])
+            continue
+        if step == EVALUATOR:
+            pack_scene(warm_up_scene())
+        elif step in (TEXTURE_NODES, OTHER_NODES):
+            compile_node_functions(_node_functions(step))
+        else:
+            scene = features_scene() if step == FEATURES else warm_up_scene(step)
+            RenderSession(scene, threads=1).run()
         _marker(step).touch()
+
+
+def _node_functions(step: str) -> list:
+    """The node functions a ``*_NODES`` step compiles: the procedural textures', or those
+    that the evaluator calls before them (in the order it calls them)."""
+    from .kernels.svm import color_nodes, image_nodes, input_nodes, math_nodes, texture_nodes
+    if step == TEXTURE_NODES:
+        return [texture_nodes.eval_texture_node]
+    return [input_nodes.eval_input_node, math_nodes.eval_math_node,
+            color_nodes.eval_color_node, image_nodes.eval_image_node]
 
 
 def _runs_default(integrator: str) -> bool:
@@ -155,11 +183,11 @@ def _runs_default(integrator: str) -> bool:
     return integrator != integrators.DEFAULT and integrators.get(integrator).light_tracing
 
 
-def _wait_for_default(poll: float = 0.5) -> None:
-    """Until the default integrator's kernels are compiled by the process that started this
-    one (which ends this one if it stops first; if it is killed, this one ends too)."""
+def _wait_for(step: str, poll: float = 0.5) -> None:
+    """Until the process that started this one has done ``step`` (it ends this one if it
+    stops first; if it is killed, this one ends too)."""
     parent = os.getppid()
-    while not _marker(integrators.DEFAULT).exists():
+    while not _marker(step).exists():
         if os.getppid() != parent:
             raise SystemExit("mcengine.warmup: the compile that started this one has ended")
         time.sleep(poll)
@@ -169,22 +197,19 @@ def compile_kernels() -> float:
     """Compile (or load) every integrator's kernels, the default one first, and the
     features'; seconds taken.
 
-    The other integrators are compiled by a second process once this one has put the
-    shader evaluator into the cache (about 230 s); this one compiles the features after the
-    path tracer (about 50 s), and the two end within half a minute of each other (a fresh
-    clone's .ci/run at 26dbcbf: about 8 min 10 s in all)."""
-    from .packing import pack_scene
+    A second process shares the work (the module's docstring says how); this one compiles
+    the features after the path tracer (about 50 s)."""
     start = time.perf_counter()
     others = sorted(set(integrators.NAMES) - {integrators.DEFAULT})
-    first = [name for name in others if not _runs_default(name)]
-    then = [name for name in others if _runs_default(name)]
+    helper_steps = [OTHER_NODES, WAIT + EVALUATOR,
+                    *[name for name in others if not _runs_default(name)],
+                    WAIT + integrators.DEFAULT, *[name for name in others if _runs_default(name)]]
     helper = None
     try:
-        pack_scene(warm_up_scene())        # compiles the shader evaluator
-        helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--only", *first,
-                                   "--then", *then],
+        helper = subprocess.Popen([sys.executable, "-m", "mcengine.warmup", "--steps",
+                                   *helper_steps],
                                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
-        _compile([integrators.DEFAULT, FEATURES])
+        _compile([TEXTURE_NODES, EVALUATOR, integrators.DEFAULT, FEATURES])
         if helper.wait() != 0:
             raise RuntimeError(f"compiling the kernels of {', '.join(others)} failed "
                                f"(exit status {helper.returncode})")
@@ -199,13 +224,8 @@ def main(argv=None) -> int:
     args = sys.argv[1:] if argv is None else argv
     # The add-on ends the background compile with SIGTERM: end the helper process too.
     signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
-    if args[:1] == ["--only"]:
-        steps = args[1:]
-        cut = steps.index("--then") if "--then" in steps else len(steps)
-        _compile(steps[:cut])
-        if steps[cut + 1:]:
-            _wait_for_default()
-            _compile(steps[cut + 1:])
+    if args[:1] == ["--steps"]:
+        _compile(args[1:])
         return 0
     if jit.cache_is_ready():
         print("mcengine: kernels already compiled")

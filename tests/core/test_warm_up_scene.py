@@ -6,11 +6,15 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import pytest
+from numba import typeof
 
 from mcengine import background, displacement, integrators, packing
-from mcengine.kernels import classic, intersect, light_tracing, motion, path, shadows
+from mcengine.kernels import classic, intersect, light_tracing, motion, path, shading, shadows
+from mcengine.kernels.surface import SurfacePoint
 from mcengine.session import RenderSession
+from mcengine.shaders import node_argument_types
 from mcengine.warmup import _runs_default, features_scene, warm_up_scene
 
 
@@ -74,3 +78,17 @@ def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):
     RenderSession(features_scene(), threads=1).run()
     assert called == {"bake_background", "emission_estimates", "build_bvh", "moving_closest",
                       "moving_occluded", "ray_masks", "displacement_offsets"}
+
+
+def test_node_functions_compiled_alone_get_the_evaluators_argument_types():
+    """The warm-up compiles some node functions on their own (``compile_node_functions``),
+    for the types that the shader evaluator then calls them with, so that it finds them in
+    the cache: a packed scene's registers and textures, and the ``ShadingData`` that
+    ``shading_data`` builds (other types would compile copies that nothing uses)."""
+    sc = packing.pack_scene(warm_up_scene()).sc
+    sp = SurfacePoint(*[0.5] * len(SurfacePoint._fields))
+    sd = shading.shading_data.py_func(sp, 0.0, 0.0, -1.0, True, True, True, False, 3, 0.2, 0.3, 1,
+                                      0, 1.0, (0, 0, 0, 0, 0), 0.0)
+    expected = (typeof(np.int64(0)), typeof(sc.svm_regs.copy()), typeof(np.int64(0)),
+                typeof(np.int64(0)), typeof(sd), typeof(sc.tex))
+    assert node_argument_types() == expected

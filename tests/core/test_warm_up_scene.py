@@ -48,7 +48,8 @@ def test_the_warm_up_render_runs_every_kernel_of_the_integrator(name, monkeypatc
 @pytest.mark.parametrize("name", sorted(set(integrators.NAMES) - {integrators.DEFAULT}))
 def test_the_second_compile_process_waits_for_the_default_kernels_it_runs(name, monkeypatch):
     """The warm-up's second process renders an integrator that runs the default one's
-    kernels only once the first has compiled them (``--then``): else both compile them."""
+    kernels only after waiting for the first to compile them (its step ``wait:path``, for
+    the integrators ``_runs_default`` names): else both would compile them."""
     assert integrators.DEFAULT == "path"
     called = []
     for kernel in _kernels(path):

@@ -28,6 +28,12 @@
   sampling a closure list) are called, not inlined: they cost far more than a
   call, and inlining them into every caller made compilation take many
   minutes.
+* ``by_ref`` / ``deref``: numba passes a tuple argument by value, every field
+  of it (a ``ShadingData`` is 31 machine words, a ``TextureData`` of eight
+  arrays 68), which a caller stores anew for every call; a function called
+  many times with the same large tuple takes its address instead (one word).
+  Measured on a call in a loop: 40 ns with both tuples by value, 15 ns by
+  reference.
 * ``_nrt=False``: no reference counting of arrays.  With it, numba wraps
   every array it takes out of a tuple or hands to a helper in atomic
   increments and decrements, which measured 28 % of the render time.  The
@@ -39,8 +45,9 @@ import os
 import shutil
 from pathlib import Path
 
-from numba import njit
-from numba.core import config
+from numba import njit, types
+from numba.core import cgutils, config
+from numba.extending import intrinsic
 
 from . import numba_patches
 
@@ -107,3 +114,29 @@ device = _cached(njit(cache=True, error_model="numpy", inline="always", _nrt=Fal
 builder = _cached(njit(cache=True, error_model="numpy"))
 function = _cached(njit(cache=True, error_model="numpy", _nrt=False))
 kernel = _cached(njit(cache=True, nogil=True, error_model="numpy", _nrt=False))
+
+
+@intrinsic
+def by_ref(typingctx, value):
+    """The address of a copy of ``value`` (a tuple) in the caller's stack frame, to pass to a
+    ``function`` instead of the value (``deref`` reads it there).  Valid until the caller
+    returns: never return it or store it in an array.  A call in a loop should get it made
+    once, before the loop: the copy is made where ``by_ref`` is."""
+    def codegen(context, builder, signature, args):
+        model = context.data_model_manager[signature.args[0]]
+        address = cgutils.alloca_once(builder, model.get_data_type())
+        builder.store(model.as_data(builder, args[0]), address)
+        return address
+    return types.CPointer(value)(value), codegen
+
+
+@intrinsic
+def deref(typingctx, ref):
+    """The value whose address ``by_ref`` gave (only the fields used are read)."""
+    def codegen(context, builder, signature, args):
+        model = context.data_model_manager[signature.return_type]
+        value = model.from_data(builder, builder.load(args[0]))
+        if context.enable_nrt:          # a new reference, as numba counts them
+            context.nrt.incref(builder, signature.return_type, value)
+        return value
+    return ref.dtype(ref), codegen

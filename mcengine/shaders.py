@@ -80,8 +80,8 @@ from .kernels.svm import (
     ShadingData,
     TextureData,
     closures_only,
-    eval_node,
     eval_shader,
+    fold_node,
 )
 from .kernels.svm.bump import BS_SIZE
 from .kernels.svm.nodes import (
@@ -520,7 +520,7 @@ class _Compiler:
         """Evaluate a pure node with constant inputs now, with the kernels' own code."""
         regs = np.concatenate([np.asarray(v.const, float) for v in values] + [np.zeros(64)])
         out = sum(len(v.const) for v in values)
-        eval_node(spec.code, regs, 0, out, _HOST_POINT, NO_TEXTURES)
+        fold_node(spec.code, regs, 0, out, _HOST_POINT, NO_TEXTURES)
         outputs, k = {}, out
         for socket in spec.outputs:
             n = SIZE[socket.type]
@@ -599,19 +599,20 @@ NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32), no_local_bvh())
 
 def compile_node_functions(functions) -> None:
     """Compile node functions of the shader evaluator (``kernels.svm``'s ``eval_*_node``,
-    which take (code, regs, b, c[, sd, tex])) for the argument types that the evaluator and
-    the folding above give them, without running them: ``mcengine.warmup`` compiles some in
-    a second process while the first compiles the others."""
+    which take (code, regs, b, c[, sd_ref, tex_ref])) for the argument types that the
+    evaluator and the folding above give them, without running them: ``mcengine.warmup``
+    compiles some in a second process while the first compiles the others."""
     types = node_argument_types()
     for function in functions:
         function.compile(types[:function.py_func.__code__.co_argcount])
 
 
 def node_argument_types() -> tuple:
-    """numba's types of (code, regs, b, c, sd, tex) as the folding passes them to a node."""
-    from numba import typeof
-    return tuple(typeof(value) for value in (np.int64(0), np.zeros(1), np.int64(0), np.int64(0),
-                                              _HOST_POINT, NO_TEXTURES))
+    """numba's types of (code, regs, b, c, sd_ref, tex_ref) as the folding passes them to a
+    node (the point and the texture data by reference, ``jit.by_ref``)."""
+    from numba import typeof, types
+    return (*(typeof(value) for value in (np.int64(0), np.zeros(1), np.int64(0), np.int64(0))),
+            types.CPointer(typeof(_HOST_POINT)), types.CPointer(typeof(NO_TEXTURES)))
 
 
 class ShaderTable:

@@ -1,4 +1,5 @@
-"""mcengine.numba_patches (installed by mcengine.jit): faster compiles, the same programs."""
+"""mcengine.jit's tuples by reference, and mcengine.numba_patches (installed by mcengine.jit):
+faster compiles, the same programs."""
 from __future__ import annotations
 
 import copy
@@ -12,7 +13,44 @@ from numba.core import inline_closurecall as inlining
 from numba.core.registry import cpu_target
 
 import mcengine.jit  # noqa: F401  (installs the changes)
+from mcengine.jit import by_ref, deref
 from mcengine.kernels import light_tracing, path
+from mcengine.kernels.svm import ShadingData
+from mcengine.shaders import NO_TEXTURES
+
+
+@njit(_nrt=False)
+def _fields(ref):
+    """Called, not inlined: what it reads through a ``by_ref`` address."""
+    return deref(ref)
+
+
+@njit(_nrt=False)
+def _mark(ref, k):
+    deref(ref).pixf[k] = k
+
+
+@njit(_nrt=False)
+def _through_refs(sd, tex):
+    tex_ref = by_ref(tex)
+    for k in range(tex.pixf.shape[0]):      # one address for every call
+        _mark(tex_ref, k)
+    return _fields(by_ref(sd))
+
+
+def test_a_tuple_passed_by_reference_reads_as_the_value():
+    """Every field of a ``ShadingData`` (floats, booleans, integers, an unsigned key) comes
+    back as it was; an array of a ``TextureData`` is the caller's own (writes reach it)."""
+    values = [float(k) + 0.25 for k in range(len(ShadingData._fields))]
+    sd = ShadingData(*values)._replace(backfacing=True, allocate=False, reflective_caustics=True,
+                                       refractive_caustics=False, bump_correction=True,
+                                       prim=np.int64(-7), obj=np.int64(123456789012), path_flags=np.int64(5),
+                                       depth=np.int64(2), diffuse_depth=np.int64(1), glossy_depth=np.int64(0),
+                                       transmission_depth=np.int64(3), transparent_depth=np.int64(4),
+                                       rng=np.uint64(2**64 - 3))
+    tex = NO_TEXTURES._replace(pixf=np.zeros(5, np.float32))
+    assert _through_refs(sd, tex) == sd
+    np.testing.assert_array_equal(tex.pixf, np.arange(5))
 
 
 @njit(inline="always")

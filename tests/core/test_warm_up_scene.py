@@ -8,7 +8,7 @@ import functools
 
 import numpy as np
 import pytest
-from numba import typeof
+from numba import typeof, types
 
 from mcengine import background, displacement, integrators, packing
 from mcengine.kernels import classic, intersect, light_tracing, motion, path, shading, shadows
@@ -84,12 +84,13 @@ def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):
 def test_node_functions_compiled_alone_get_the_evaluators_argument_types():
     """The warm-up compiles some node functions on their own (``compile_node_functions``),
     for the types that the shader evaluator then calls them with, so that it finds them in
-    the cache: a packed scene's registers and textures, and the ``ShadingData`` that
-    ``shading_data`` builds (other types would compile copies that nothing uses)."""
+    the cache: a packed scene's registers, and the addresses (``jit.by_ref``) of its textures
+    and of the ``ShadingData`` that ``shading_data`` builds (other types would compile copies
+    that nothing uses)."""
     sc = packing.pack_scene(warm_up_scene()).sc
     sp = SurfacePoint(*[0.5] * len(SurfacePoint._fields))
     sd = shading.shading_data.py_func(sp, 0.0, 0.0, -1.0, True, True, True, False, 3, 0.2, 0.3, 1,
                                       0, 1.0, (0, 0, 0, 0, 0), 0.0)
     expected = (typeof(np.int64(0)), typeof(sc.svm_regs.copy()), typeof(np.int64(0)),
-                typeof(np.int64(0)), typeof(sd), typeof(sc.tex))
+                typeof(np.int64(0)), types.CPointer(typeof(sd)), types.CPointer(typeof(sc.tex)))
     assert node_argument_types() == expected

@@ -44,7 +44,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...jit import device, function
+from ...jit import by_ref, deref, device, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from ..scalar import saturate
 from .ao import ao_node
@@ -125,24 +125,32 @@ NO_RESULT = ShaderResult(np.int64(0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # bef
 
 
 @device
-def eval_node(code, regs, b, c, sd, tex):
-    """Evaluate value node ``code``: inputs at regs[b:], outputs to regs[c:]."""
+def eval_node(code, regs, b, c, sd_ref, tex_ref):
+    """Evaluate value node ``code``: inputs at regs[b:], outputs to regs[c:]; the point and
+    the texture data by reference (``jit.by_ref``)."""
     family = code // 100
     if family == FAMILY_INPUT:
-        eval_input_node(code, regs, b, c, sd, tex)
-    elif family == FAMILY_MATH:          # these two read neither the point nor the scene,
-        eval_math_node(code, regs, b, c)   # which a call would copy (about 100 words)
+        eval_input_node(code, regs, b, c, sd_ref, tex_ref)
+    elif family == FAMILY_MATH:          # these two read neither the point nor the scene
+        eval_math_node(code, regs, b, c)
     elif family == FAMILY_COLOR:
         eval_color_node(code, regs, b, c)
     elif family == FAMILY_TEXTURE:
         if code >= IMAGE_CODES:
-            eval_image_node(code, regs, b, c, sd, tex)
+            eval_image_node(code, regs, b, c, sd_ref, tex_ref)
         else:
-            eval_texture_node(code, regs, b, c, sd, tex)
+            eval_texture_node(code, regs, b, c, sd_ref, tex_ref)
     elif family == FAMILY_VECTOR:
-        eval_vector_node(code, regs, b, c, sd, tex)
+        eval_vector_node(code, regs, b, c, sd_ref, tex_ref)
     elif family == FAMILY_NORMAL:
-        eval_normal_node(code, regs, b, c, sd, tex)
+        eval_normal_node(code, regs, b, c, sd_ref, tex_ref)
+
+
+@function
+def fold_node(code, regs, b, c, sd, tex):
+    """``eval_node`` with the point and the texture data by value: the shader compiler's
+    constant folding calls it on the host."""
+    eval_node(code, regs, b, c, by_ref(sd), by_ref(tex))
 
 
 @device
@@ -160,21 +168,21 @@ def convert(regs, a, b, kind):
 
 
 @device
-def eval_row(ops, pc, regs, sd, tex, verts, tris, local):
+def eval_row(ops, pc, regs, sd_ref, tex_ref, verts, tris, local):
     """One value row: OP_NODE, OP_COPY or OP_CONVERT."""
     op = ops[pc, 0]
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if op == OP_NODE:
         if a == _WIREFRAME:         # the nodes that read the triangles themselves
-            wireframe_node(regs, b, c, sd, verts, tris)
+            wireframe_node(regs, b, c, deref(sd_ref), verts, tris)
         elif a == _DPDV:
-            dpdv_node(regs, c, sd, verts, tris)
+            dpdv_node(regs, c, deref(sd_ref), verts, tris)
         elif a == _BEVEL:
-            bevel_node(regs, b, c, sd, tex, verts, tris, local)
+            bevel_node(regs, b, c, deref(sd_ref), deref(tex_ref), verts, tris, local)
         elif a == _AO:
-            ao_node(regs, b, c, sd, tex, verts, tris, local)
+            ao_node(regs, b, c, deref(sd_ref), deref(tex_ref), verts, tris, local)
         else:
-            eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd, tex)   # as the compiler folds
+            eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd_ref, tex_ref)   # as the compiler folds
     elif op == OP_COPY:
         for k in range(c):
             regs[a + k] = regs[b + k]
@@ -183,18 +191,19 @@ def eval_row(ops, pc, regs, sd, tex, verts, tris, local):
 
 
 @function
-def eval_values(ops, start, end, regs, sd, tex, verts, tris, local):
-    """Run value rows [start, end) at ``sd``: the Height sub-graph of a Bump node, or the
-    output's Displacement; a Bump node in there moves the point again from ``sd``."""
-    point = sd
+def eval_values(ops, start, end, regs, sd_ref, tex_ref, verts, tris, local):
+    """Run value rows [start, end) at the point ``sd_ref`` (by reference, as the texture
+    data): the Height sub-graph of a Bump node, or the output's Displacement; a Bump node in
+    there moves the point again from that point."""
+    point = sd_ref
     for pc in range(start, end):
         if ops[pc, 0] == OP_BUMP:
             if ops[pc, 1] == BUMP_LEAVE:
-                point = sd
+                point = sd_ref
             else:
-                point = region_point(ops, pc, regs, sd, tex, verts, tris)
+                point = by_ref(region_point(ops, pc, regs, deref(sd_ref), deref(tex_ref), verts, tris))
         else:
-            eval_row(ops, pc, regs, point, tex, verts, tris, local)
+            eval_row(ops, pc, regs, point, tex_ref, verts, tris, local)
 
 
 @device
@@ -213,11 +222,13 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
     ``local`` the hierarchies (``subsurface.LocalBVH``) that Bevel and Ambient Occlusion nodes
     trace (not in ``tex``: every node function takes that, and a call copies its arrays)."""
     res = NO_RESULT
+    tex_ref = by_ref(tex)     # node functions take the point and the textures by reference
     if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:
         surface, b = start + ops[start, 3], ops[start, 2]
-        eval_values(ops, start + 1, surface, regs, sd, tex, verts, tris, local)
+        eval_values(ops, start + 1, surface, regs, by_ref(sd), tex_ref, verts, tris, local)
         sd = with_normal(sd, regs[b], regs[b + 1], regs[b + 2])
         start = surface
+    sd_ref = by_ref(sd)
     skip = start             # rows before it were run by eval_values
     for pc in range(start, end):
         if pc < skip:
@@ -227,10 +238,10 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
             res = closure_row(ops, pc, regs, cl, sd, res)
         elif op == OP_BUMP:
             eval_values(ops, pc + 1, pc + ops[pc, 3], regs,
-                        region_point(ops, pc, regs, sd, tex, verts, tris), tex, verts, tris, local)
+                        by_ref(region_point(ops, pc, regs, sd, tex, verts, tris)), tex_ref, verts, tris, local)
             skip = pc + ops[pc, 3] + 1
         else:
-            eval_row(ops, pc, regs, sd, tex, verts, tris, local)
+            eval_row(ops, pc, regs, sd_ref, tex_ref, verts, tris, local)
     return res
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device, function
+from ...jit import deref, device, function
 from ..colorspace import XYZ_TO_RGB
 from ..scalar import safe_acos, saturate
 from .data import (
@@ -86,7 +86,10 @@ _INV_255 = 1.0 / 255.0
 
 
 @function
-def eval_image_node(code, regs, b, c, sd, tex):
+def eval_image_node(code, regs, b, c, sd_ref, tex_ref):
+    """An image node: inputs at regs[b:], outputs to regs[c:]; the point and the texture
+    data by reference (``jit.by_ref``)."""
+    sd, tex = deref(sd_ref), deref(tex_ref)
     if code == _TEX_IMAGE:
         image_texture_node(regs, b, c, sd, tex)
     elif code == _TEX_ENVIRONMENT:

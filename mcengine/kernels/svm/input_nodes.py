@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device, function
+from ...jit import deref, device, function
 from ..camera import C_FWD, C_HALF_H, C_HALF_W, C_POS, C_RIGHT, C_SHIFT_X, C_SHIFT_Y, C_TYPE, C_UP, CAM_ORTHO
 from ..closures.fresnel import fresnel_dielectric
 from ..state import PF_CAMERA, PF_DIFFUSE, PF_EMISSION, PF_GLOSSY, PF_REFLECT, PF_SHADOW, PF_SINGULAR, PF_TRANSMIT
@@ -65,7 +65,10 @@ _RANDOM_SCALE = 1.0 / 4294967295.0       # Object Info Random: the object's 32-b
 
 
 @function
-def eval_input_node(code, regs, b, c, sd, tex):
+def eval_input_node(code, regs, b, c, sd_ref, tex_ref):
+    """An input node: inputs at regs[b:], outputs to regs[c:]; the point and the texture
+    data by reference (``jit.by_ref``)."""
+    sd, tex = deref(sd_ref), deref(tex_ref)
     if code == _TEX_COORD:
         tex_coord(regs, b, c, sd, tex)
     elif code == _UV_MAP:

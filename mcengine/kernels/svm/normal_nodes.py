@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device, function
+from ...jit import deref, device, function
 from .bump import bump_normal, displacement, vector_displacement
 from .input_nodes import attribute, normal_to_object, normal_to_world
 from .math_nodes import safe_normalize
@@ -37,7 +37,10 @@ _VECTOR_DISPLACEMENT = NODES["VectorDisplacement"].code
 
 
 @function
-def eval_normal_node(code, regs, b, c, sd, tex):
+def eval_normal_node(code, regs, b, c, sd_ref, tex_ref):
+    """A node of normals and displacement: inputs at regs[b:], outputs to regs[c:]; the point and the texture
+    data by reference (``jit.by_ref``)."""
+    sd, tex = deref(sd_ref), deref(tex_ref)
     if code == _NORMAL_MAP:
         x, y, z = normal_map(regs, b, sd, tex)
         regs[c], regs[c + 1], regs[c + 2] = x, y, z

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device, function
+from ...jit import deref, device, function
 from ..ies import ies_direction
 from ..scalar import saturate
 from .gabor import gabor_node
@@ -96,7 +96,9 @@ _HALF_PI_F = r32(0.5 * math.pi)
 
 
 @function
-def eval_texture_node(code, regs, b, c, sd, tex):
+def eval_texture_node(code, regs, b, c, sd_ref, tex_ref):
+    """A procedural texture: inputs at regs[b:], outputs to regs[c:]; the point and the texture
+    data by reference (``jit.by_ref``)."""
     if code == _CHECKER:
         checker_node(regs, b, c)
     elif code == _NOISE:
@@ -116,7 +118,7 @@ def eval_texture_node(code, regs, b, c, sd, tex):
     elif code == _GABOR:
         gabor_node(regs, b, c)
     elif code == _IES:
-        ies_node(regs, b, c, sd, tex)
+        ies_node(regs, b, c, deref(sd_ref), deref(tex_ref))
 
 
 @function

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ...jit import device, function
+from ...jit import deref, device, function
 from ..camera import C_FWD, C_POS, C_RIGHT, C_UP
 from .data import OBJ_INVERSE, OBJ_MATRIX
 from .input_nodes import (
@@ -60,13 +60,15 @@ _NORMAL = VECTOR_TYPES["NORMAL"]
 
 
 @function
-def eval_vector_node(code, regs, b, c, sd, tex):
+def eval_vector_node(code, regs, b, c, sd_ref, tex_ref):
+    """A vector node: inputs at regs[b:], outputs to regs[c:]; the point and the texture data
+    by reference (``jit.by_ref``)."""
     if code == _MAPPING:
         mapping_node(regs, b, c)
     elif code == _VECTOR_ROTATE:
         vector_rotate(regs, b, c)
     elif code == _VECTOR_TRANSFORM:
-        vector_transform(regs, b, c, sd, tex)
+        vector_transform(regs, b, c, deref(sd_ref), deref(tex_ref))
     elif code == _NORMAL_NODE:
         normal_node(regs, b, c)
 

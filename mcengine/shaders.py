@@ -598,21 +598,28 @@ NO_MESH = (np.zeros((0, 3)), np.zeros((0, 3), np.int32), no_local_bvh())
 
 
 def compile_node_functions(functions) -> None:
-    """Compile node functions of the shader evaluator (``kernels.svm``'s ``eval_*_node``,
-    which take (code, regs, b, c[, sd_ref, tex_ref])) for the argument types that the
-    evaluator and the folding above give them, without running them: ``mcengine.warmup``
+    """Compile functions that the shader evaluator calls (``kernels.svm``'s node functions
+    ``eval_*_node`` and closure nodes' ``principled``, ``glossy``, ...) for the argument types
+    it gives them (``evaluator_argument_types``), without running them: ``mcengine.warmup``
     compiles some in a second process while the first compiles the others."""
-    types = node_argument_types()
     for function in functions:
-        function.compile(types[:function.py_func.__code__.co_argcount])
+        function.compile(evaluator_argument_types(function))
 
 
-def node_argument_types() -> tuple:
-    """numba's types of (code, regs, b, c, sd_ref, tex_ref) as the folding passes them to a
-    node (the point and the texture data by reference, ``jit.by_ref``)."""
+def evaluator_argument_types(function) -> tuple:
+    """numba's types of what the shader evaluator (and the folding above) passes to
+    ``function``, named by its parameters: a node function's (code, regs, b, c[, sd_ref,
+    tex_ref]: the point and the texture data by reference, ``jit.by_ref``), a closure node's
+    (regs, b[, mix_weight], cl, n, sd[, cr, cg, cb])."""
     from numba import typeof, types
-    return (*(typeof(value) for value in (np.int64(0), np.zeros(1), np.int64(0), np.int64(0))),
-            types.CPointer(typeof(_HOST_POINT)), types.CPointer(typeof(NO_TEXTURES)))
+    i64, f64 = typeof(np.int64(0)), typeof(0.0)
+    known = {"code": i64, "b": i64, "c": i64, "n": i64, "regs": typeof(np.zeros(1)),
+             "cl": typeof(np.zeros((MAX_CLOSURES, CL_STRIDE))), "mix_weight": f64, "w": f64,
+             "cr": f64, "cg": f64, "cb": f64,
+             "sd": typeof(_HOST_POINT), "sd_ref": types.CPointer(typeof(_HOST_POINT)),
+             "tex_ref": types.CPointer(typeof(NO_TEXTURES))}
+    code = function.py_func.__code__
+    return tuple(known[name] for name in code.co_varnames[:code.co_argcount])
 
 
 class ShaderTable:

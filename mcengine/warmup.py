@@ -15,14 +15,14 @@ the scene uses), and one of a scene with what else a render may compile
 displacement),
 then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core, so a
 second process (``python -m mcengine.warmup --steps STEP...``) shares the work: while this
-one compiles the procedural textures' node function, it compiles the input, math, colour
-and image nodes' (the shader evaluator's first callees, which this one then finds in the
-cache); once this one has compiled the rest of the evaluator, which every integrator calls,
-the second compiles the other integrators while this one compiles the default integrator
-and the features.  The integrators that trace light paths beside camera paths run the
-default integrator's kernels too, so the second process renders them once this one has put
-those in the cache.  A step ``wait:NAME`` waits for step NAME of this process; otherwise
-each process would compile what the other is compiling.
+one compiles the procedural textures' node function, it compiles the evaluator's other node
+functions and the closure nodes' (which this one then finds in the cache); once this one
+has compiled the rest of the evaluator, which every integrator calls, the second compiles
+the other integrators while this one compiles the default integrator and the features.  The
+integrators that trace light paths beside camera paths run the default integrator's kernels
+too, so the second process renders them once this one has put those in the cache.  A step
+``wait:NAME`` waits for step NAME of this process; otherwise each process would compile
+what the other is compiling.
 Compiling every integrator here matters beyond the wait: numba compiling inside a
 Blender process where Cycles has rendered can crash that process (seen with bpy
 5.0.1: a segfault in the next render), so a user's first Whitted render after a
@@ -168,13 +168,26 @@ def _compile(steps) -> None:
 
 
 def _node_functions(step: str) -> list:
-    """The node functions a ``*_NODES`` step compiles: the procedural textures', or those
-    that the evaluator calls before them (in the order it calls them)."""
-    from .kernels.svm import color_nodes, image_nodes, input_nodes, math_nodes, texture_nodes
+    """The functions a ``*_NODES`` step compiles: the procedural textures' node function, or
+    those that the evaluator calls before or after it (the other node functions and the
+    closure nodes', in the order it compiles them)."""
+    from .kernels.svm import (
+        closure_nodes,
+        color_nodes,
+        image_nodes,
+        input_nodes,
+        math_nodes,
+        normal_nodes,
+        texture_nodes,
+        vector_nodes,
+    )
     if step == TEXTURE_NODES:
         return [texture_nodes.eval_texture_node]
     return [input_nodes.eval_input_node, math_nodes.eval_math_node,
-            color_nodes.eval_color_node, image_nodes.eval_image_node]
+            color_nodes.eval_color_node, image_nodes.eval_image_node,
+            vector_nodes.eval_vector_node, normal_nodes.eval_normal_node,
+            closure_nodes.principled, closure_nodes.glossy, closure_nodes.metallic,
+            closure_nodes.glass]
 
 
 def _runs_default(integrator: str) -> bool:

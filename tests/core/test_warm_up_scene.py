@@ -11,11 +11,18 @@ import pytest
 from numba import typeof, types
 
 from mcengine import background, displacement, integrators, packing
-from mcengine.kernels import classic, intersect, light_tracing, motion, path, shading, shadows
+from mcengine.kernels import classic, intersect, light_tracing, motion, path, shading, shadows, state
 from mcengine.kernels.surface import SurfacePoint
 from mcengine.session import RenderSession
-from mcengine.shaders import node_argument_types
-from mcengine.warmup import _runs_default, features_scene, warm_up_scene
+from mcengine.shaders import evaluator_argument_types
+from mcengine.warmup import (
+    OTHER_NODES,
+    TEXTURE_NODES,
+    _node_functions,
+    _runs_default,
+    features_scene,
+    warm_up_scene,
+)
 
 
 def _kernels(module) -> list[str]:
@@ -81,16 +88,26 @@ def test_the_features_render_runs_the_kernels_of_what_it_shows(monkeypatch):
                       "moving_occluded", "ray_masks", "displacement_offsets"}
 
 
-def test_node_functions_compiled_alone_get_the_evaluators_argument_types():
-    """The warm-up compiles some node functions on their own (``compile_node_functions``),
-    for the types that the shader evaluator then calls them with, so that it finds them in
-    the cache: a packed scene's registers, and the addresses (``jit.by_ref``) of its textures
-    and of the ``ShadingData`` that ``shading_data`` builds (other types would compile copies
-    that nothing uses)."""
+def test_functions_compiled_alone_get_the_evaluators_argument_types():
+    """The warm-up compiles some of the evaluator's functions on their own
+    (``compile_node_functions``), for the types that the shader evaluator then calls them
+    with, so that it finds them in the cache: a worker's registers and closure list, indices
+    and weights as the evaluator makes them (int64, float64), the ``ShadingData`` that
+    ``shading_data`` builds and the scene's textures, or their addresses (``jit.by_ref``);
+    other types would compile copies that nothing uses."""
     sc = packing.pack_scene(warm_up_scene()).sc
+    scratch = state.alloc_scratch(sc)
     sp = SurfacePoint(*[0.5] * len(SurfacePoint._fields))
     sd = shading.shading_data.py_func(sp, 0.0, 0.0, -1.0, True, True, True, False, 3, 0.2, 0.3, 1,
                                       0, 1.0, (0, 0, 0, 0, 0), 0.0)
-    expected = (typeof(np.int64(0)), typeof(sc.svm_regs.copy()), typeof(np.int64(0)),
-                typeof(np.int64(0)), types.CPointer(typeof(sd)), types.CPointer(typeof(sc.tex)))
-    assert node_argument_types() == expected
+    index, weight = typeof(np.int64(0)), typeof(scratch.regs[0] * 1.0)
+    real = {"code": index, "b": index, "c": index, "n": index, "regs": typeof(scratch.regs),
+            "cl": typeof(scratch.cl), "mix_weight": weight, "w": weight,
+            "cr": weight, "cg": weight, "cb": weight, "sd": typeof(sd),
+            "sd_ref": types.CPointer(typeof(sd)), "tex_ref": types.CPointer(typeof(sc.tex))}
+    functions = _node_functions(OTHER_NODES) + _node_functions(TEXTURE_NODES)
+    assert {f.__name__ for f in functions} >= {"eval_input_node", "eval_image_node", "principled"}
+    for function in functions:
+        code = function.py_func.__code__
+        expected = tuple(real[name] for name in code.co_varnames[:code.co_argcount])
+        assert evaluator_argument_types(function) == expected, function.__name__

@@ -38,8 +38,8 @@ _VECTOR_DISPLACEMENT = NODES["VectorDisplacement"].code
 
 @function
 def eval_normal_node(code, regs, b, c, sd_ref, tex_ref):
-    """A node of normals and displacement: inputs at regs[b:], outputs to regs[c:]; the point and the texture
-    data by reference (``jit.by_ref``)."""
+    """A node of normals and displacement: inputs at regs[b:], outputs to regs[c:]; the point
+    and the texture data by reference (``jit.by_ref``)."""
     sd, tex = deref(sd_ref), deref(tex_ref)
     if code == _NORMAL_MAP:
         x, y, z = normal_map(regs, b, sd, tex)

@@ -220,7 +220,8 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
     """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`.
     ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point,
     ``local`` the hierarchies (``subsurface.LocalBVH``) that Bevel and Ambient Occlusion nodes
-    trace (not in ``tex``: every node function takes that, and a call copies its arrays)."""
+    trace (not in ``tex``, which the node functions read through one copy per run,
+    ``jit.by_ref``: that copy would grow by seven arrays)."""
     res = NO_RESULT
     tex_ref = by_ref(tex)     # node functions take the point and the textures by reference
     if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:

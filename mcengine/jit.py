@@ -34,7 +34,8 @@
   many times with the same large tuple takes its address instead (one word).
   ``benchmarks/bench_call_cost.py``: a node-like function called in a loop
   took 43.8 ns per call with both tuples by value, 24.0 ns by reference,
-  18.6 ns inlined (no call).
+  18.6 ns inlined (no call).  ``field_ref`` is the address of one field of
+  such a tuple (the texture data inside the shader evaluator's ``ShaderScene``).
 * ``_nrt=False``: no reference counting of arrays.  With it, numba wraps
   every array it takes out of a tuple or hands to a helper in atomic
   increments and decrements, which measured 28 % of the render time.  The
@@ -47,7 +48,7 @@ import shutil
 from pathlib import Path
 
 from numba import njit, types
-from numba.core import cgutils, config
+from numba.core import cgutils, config, errors
 from numba.extending import intrinsic
 
 from . import numba_patches
@@ -141,3 +142,18 @@ def deref(typingctx, ref):
             context.nrt.incref(builder, signature.return_type, value)
         return value
     return ref.dtype(ref), codegen
+
+
+@intrinsic
+def field_ref(typingctx, ref, index):
+    """The address of field ``index`` (a constant) of the tuple whose address ``by_ref``
+    gave: a reference to part of it, without a copy."""
+    if not isinstance(index, types.IntegerLiteral):
+        raise errors.RequireLiteralValue(index)
+    i = index.literal_value
+    field = ref.dtype.types[i]
+
+    def codegen(context, builder, signature, args):
+        zero = context.get_constant(types.int32, 0)
+        return builder.gep(args[0], [zero, context.get_constant(types.int32, i)])
+    return types.CPointer(field)(ref, index), codegen

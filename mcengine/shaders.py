@@ -77,10 +77,11 @@ from .kernels.svm import (
     OP_MIX_WEIGHT,
     OP_NODE,
     RGB_TO_Y,
+    ShaderScene,
     ShadingData,
     TextureData,
     closures_only,
-    eval_shader,
+    eval_shader_by_value,
     fold_node,
 )
 from .kernels.svm.bump import BS_SIZE
@@ -663,8 +664,8 @@ class ShaderTable:
         point = _HOST_POINT._replace(allocate=False, bump_correction=False)
         for i, (m, program) in enumerate(zip(materials, programs)):
             point = point._replace(bump_correction=m.use_bump_map_correction)
-            res = eval_shader(self.ops, self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
-                              NO_TEXTURES, *NO_MESH)
+            res = eval_shader_by_value(self.ranges[i, 0], self.ranges[i, 1], regs, cl, point,
+                                       ShaderScene(self.ops, NO_TEXTURES, *NO_MESH))
             self.emitted[i] = (res.er, res.eg, res.eb)
             flags = MF_BUMP_CORRECTION if m.use_bump_map_correction else 0
             if self.emitted[i].max() > 0.0 or program.emission_varies:

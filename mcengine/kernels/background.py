@@ -30,11 +30,11 @@ import math
 
 import numpy as np
 
-from ..jit import device, kernel
+from ..jit import by_ref, device, kernel
 from .light_sampling import pick_light
 from .sampling import orthonormal_basis
 from .state import CFG_WORLD_SHADER
-from .svm import ShadingData, eval_shader
+from .svm import ShadingData, eval_shader, shader_scene
 from .svm.image_nodes import direction_to_equirectangular
 
 
@@ -53,8 +53,8 @@ def world_radiance(sc, cfg, scratch, dx, dy, dz, flags):
                      i64(-1), 0.0, 0.0, i64(-1), i64(flags), math.inf,
                      i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
     w = sc.mat_prog.shape[0] - 1
-    res = eval_shader(sc.svm_ops, sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs,
-                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris, sc.local)
+    res = eval_shader(sc.mat_prog[w, 0], sc.mat_prog[w, 1], scratch.regs, scratch.cl_light, sd,
+                      by_ref(shader_scene(sc)))
     return res.er, res.eg, res.eb
 
 

@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from ..jit import device, kernel
+from ..jit import by_ref, device, kernel
 from .camera import generate_camera_rays
 from .closures.layout import (
     CL_AX,
@@ -83,6 +83,7 @@ from .state import (
     ST_SELF_HITS,
 )
 from .surface import hit_distance, past_self_hit, surface_point
+from .svm import shader_scene
 from .svm.nodes import K_GLASS, K_GLOSSY, K_METALLIC, K_PRINCIPLED, K_REFRACTION, K_TRANSPARENT
 
 # Integer codes of the classic integrators in the kernels: ``IntegratorInfo.kernel_code``
@@ -158,6 +159,7 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
     n_shadow = 0
     n_lamps = sc.lamps.shape[0]
     lamps_hit = cfg[CFG_LAMPS_HIT] != 0
+    scene_ref = by_ref(shader_scene(sc))
     for i in range(start, end):
         p = prim[i]
         ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
@@ -199,8 +201,8 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
         depths = (st.bounce[i], st.diffuse[i], st.glossy[i], st.transmission[i], st.transparent[i])
         # Ray differentials on camera rays only (Bump nodes leave later levels' normals alone).
         footprint = st.dp[i] + st.dd[i] * t_hit if bounce == 0 else 0.0
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, not terminate,
-                          depths, footprint)
+        res = shade_point(sc, scene_ref, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags,
+                          not terminate, depths, footprint)
         if res.er != 0.0 or res.eg != 0.0 or res.eb != 0.0:
             light_from_emitter(sc, fcfg, stats, acc, root, st.beta, i, p, t_hit, sp,
                                flags, mis_pdf, PMF_EVERY, mp, 0.0, direct,

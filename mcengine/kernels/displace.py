@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from ..jit import by_ref, kernel
-from .svm import ShadingData, eval_values
+from .svm import ShaderScene, ShadingData, eval_values
 
 
 @kernel
@@ -30,7 +30,7 @@ def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, local, ng
     the shader evaluator takes (Bevel nodes trace nothing here, as in Cycles).  A component that is not finite
     becomes 0 (Cycles' ``ensure_finite``)."""
     i64, f64 = np.int64, np.float64
-    tex_ref = by_ref(tex)
+    scene_ref = by_ref(ShaderScene(ops, tex, verts, tris, local))
     for j in range(corner_tri.shape[0]):
         t = corner_tri[j]
         k = corner[j]
@@ -44,7 +44,7 @@ def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, local, ng
                          False, False, True, True, False, i64(t), u, v,
                          i64(tex.tri_object[t]), i64(0), 0.0,
                          i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
-        eval_values(ops, ranges[m, 0], ranges[m, 1], regs, by_ref(sd), tex_ref, verts, tris, local)
+        eval_values(ranges[m, 0], ranges[m, 1], regs, by_ref(sd), scene_ref)
         r = results[m]
         for c in range(3):
             x = regs[r + c]

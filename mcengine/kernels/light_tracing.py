@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-from ..jit import device, kernel
+from ..jit import by_ref, device, kernel
 from .camera import C_APERTURE, C_MOTION_STEPS, C_VIEW_POST, C_VIEW_PRE
 from .closures import bsdf_eval, bsdf_sample_closure, free_side
 from .closures.layout import (
@@ -96,7 +96,7 @@ from .state import (
     move_path,
 )
 from .surface import hit_distance, past_self_hit, surface_point
-from .svm import OBJ_HOLDOUT
+from .svm import OBJ_HOLDOUT, shader_scene
 
 _K_LIGHT_PATH = np.uint64(0x5851F42D4C957F2D)
 # The shutter time of every light path: light tracing is off where anything moves (``prepare``).
@@ -242,11 +242,11 @@ def adjoint_singular(cl, k, label, ngx, ngy, ngz, wix, wiy, wiz, wox, woy, woz):
 
 
 @device
-def _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t, flags):
+def _shade_for(sc, scene_ref, cfg, scratch, p, b1, b2, dx, dy, dz, t, flags):
     """Triangle p's closures at (b1, b2) for a viewer at -d (to ``scratch.cl``)."""
     sp = surface_point(sc, p, b1, b2, dx, dy, dz, _TIME)
-    res = shade_point(sc, cfg, scratch, sp, sc.mat_index[p], p, b1, b2, dx, dy, dz, t, flags, True,
-                      (0, 0, 0, 0, 0), 0.0)
+    res = shade_point(sc, scene_ref, cfg, scratch, sp, sc.mat_index[p], p, b1, b2, dx, dy, dz, t,
+                      flags, True, (0, 0, 0, 0, 0), 0.0)
     return sp, res
 
 
@@ -261,6 +261,7 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
     rh = n_pixels // rw
     max_bounce = cfg[CFG_MAX_BOUNCE]
     max_transparent = cfg[CFG_MAX_TRANSPARENT]
+    scene_ref = by_ref(shader_scene(sc))
     for i in range(n):
         p = prim[i]
         ox, oy, oz = st.ray_o[i, 0], st.ray_o[i, 1], st.ray_o[i, 2]
@@ -275,7 +276,7 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
         if p < 0 or sc.tri_area[p] <= 0.0:
             continue
         t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, math.inf, _TIME)
-        sp, res = _shade_for(sc, cfg, scratch, p, b1, b2, dx, dy, dz, t_hit, 0)
+        sp, res = _shade_for(sc, scene_ref, cfg, scratch, p, b1, b2, dx, dy, dz, t_hit, 0)
         if res.n == 0:
             continue
         hx, hy, hz = sp.hx, sp.hy, sp.hz
@@ -293,7 +294,7 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
             view = camera_sees(cam, hx, hy, hz)
             if view.ok and in_film(table, x0, y0, rw, rh, view.rx, view.ry):
                 wcx, wcy, wcz = view.wx, view.wy, view.wz
-                _, res2 = _shade_for(sc, cfg, cam_scratch, p, b1, b2, -wcx, -wcy, -wcz, view.dist,
+                _, res2 = _shade_for(sc, scene_ref, cfg, cam_scratch, p, b1, b2, -wcx, -wcy, -wcz, view.dist,
                                      PF_CAMERA | PF_TRANSPARENT_BG)
                 # x1's scattering counts towards the bounce limits of its lobe type.
                 exclude = 0
@@ -350,7 +351,7 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
                 nr, ng_, nb = st.beta[i, 0] * wr * k, st.beta[i, 1] * wg * k, st.beta[i, 2] * wb * k
             else:
                 # The light this vertex sends towards wo, from closures set up for a viewer there.
-                _, res3 = _shade_for(sc, cfg, cam_scratch, p, b1, b2, -wox, -woy, -woz, t_hit, 0)
+                _, res3 = _shade_for(sc, scene_ref, cfg, cam_scratch, p, b1, b2, -wox, -woy, -woz, t_hit, 0)
                 fr, fg, fb, _ = bsdf_eval(cam_scratch.cl, res3.n, wox, woy, woz, wix, wiy, wiz, 0)
                 k = abs(ngx * wox + ngy * woy + ngz * woz) / (cos_in * pdf)
                 nr, ng_, nb = st.beta[i, 0] * fr * k, st.beta[i, 1] * fg * k, st.beta[i, 2] * fb * k

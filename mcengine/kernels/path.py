@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ..jit import device, function, kernel
+from ..jit import by_ref, device, function, kernel
 from .camera import generate_camera_rays
 from .closures.layout import (
     CL_ANISOTROPY,
@@ -162,7 +162,7 @@ from .state import (
 )
 from .subsurface import disk_probe, random_walk
 from .surface import hit_distance, past_self_hit, surface_point
-from .svm import OBJ_HOLDOUT, OBJ_TERMINATOR_SHADING
+from .svm import OBJ_HOLDOUT, OBJ_TERMINATOR_SHADING, shader_scene
 
 
 # -- 3. shading ---------------------------------------------------------------------------------
@@ -209,6 +209,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
     sampler, mask = cfg[CFG_SAMPLER], np.uint64(cfg[CFG_SOBOL_MASK])
     walks = cfg[CFG_SUBSURFACE] != 0
     linking = cfg[CFG_LIGHT_LINKING] != 0
+    scene_ref = by_ref(shader_scene(sc))     # the shader evaluator's (svm.eval_shader)
     for i in range(n):
         st.alive[i] = 0
         p = prim[i]
@@ -292,9 +293,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             st.flags[i] = flags
             rtr = rtg = rtb = 0.0
         else:
-            res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
-                              not terminate, depths, footprint, walks, node_key(st.key[i], vertex),
-                              st.min_pdf[i])
+            res = shade_point(sc, scene_ref, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz,
+                              ray_length, flags, not terminate, depths, footprint, walks,
+                              node_key(st.key[i], vertex), st.min_pdf[i])
             ncl, rtr, rtg, rtb = res.n, res.tr, res.tg, res.tb
 
             # Holdout: the film's alpha drops by the holdout weight on camera paths. A holdout
@@ -514,8 +515,8 @@ def _exit_closure(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, fl
     cl = scratch.cl
     nx, ny, nz = sp.nsx, sp.nsy, sp.nsz
     if sc.mat_flags[m] & MF_BSSRDF_BUMP:
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, ray_length, flags,
-                          True, depths, footprint, True)
+        res = shade_point(sc, by_ref(shader_scene(sc)), cfg, scratch, sp, m, p, b1, b2, dx, dy,
+                          dz, ray_length, flags, True, depths, footprint, True)
         ax = ay = az = 0.0
         for k in range(res.n):
             if cl[k, CL_TYPE] == CT_BSSRDF:

@@ -34,7 +34,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..jit import device, kernel
+from ..jit import by_ref, device, kernel
 from .background import sample_world, world_pdf, world_radiance
 from .closures import (
     LABEL_DIFFUSE,
@@ -99,6 +99,7 @@ from .svm import (
     ShadingData,
     eval_closure_rows,
     eval_shader,
+    shader_scene,
 )
 
 DirectionSample = namedtuple("DirectionSample", [
@@ -340,8 +341,8 @@ def shading_data(sp, dx, dy, dz, allocate, reflective, refractive, bump, prim, b
 
 
 @device
-def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, allocate, depths,
-                footprint, walks=False, rng=0, min_pdf=0.0):
+def shade_point(sc, scene_ref, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags,
+                allocate, depths, footprint, walks=False, rng=0, min_pdf=0.0):
     """Run material m's shader at ``sp`` (on triangle p at barycentrics b1, b2) for a ray of
     direction d and length t_hit (from the vertex it left, through transparent surfaces, as
     Cycles measures it), on a path with ``flags`` and ``depths`` (bounces: all, diffuse,
@@ -355,7 +356,8 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
     for others they become Lambert closures of their weight (Cycles' zero-radius limit).
     A path's own shading gives ``rng``, the key of the numbers of ray-traced nodes, and
     ``min_pdf``, its smallest BSDF pdf so far; 0 (shadow rays, exits of walks): those nodes
-    trace nothing.
+    trace nothing.  ``scene_ref`` is ``by_ref(shader_scene(sc))``, made by the kernel
+    before its loop (``svm.eval_shader``).
     """
     from_diffuse = (flags & PF_DIFFUSE) != 0
     obj = sc.tex.tri_object[p]
@@ -368,8 +370,8 @@ def shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, t_hit, flags, al
         res = eval_closure_rows(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
                                 scratch.cl, sd)
     else:
-        res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                          scratch.cl, sd, sc.tex, sc.verts, sc.tris, sc.local)
+        res = eval_shader(sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl, sd,
+                          scene_ref)
     if not walks:
         for k in range(res.n):
             if scratch.cl[k, CL_TYPE] == CT_BSSRDF:
@@ -394,8 +396,8 @@ def emission_at(sc, scratch, tri, b1, b2, dx, dy, dz, dist, depths, time):
     sp = surface_point(sc, tri, b1, b2, dx, dy, dz, time)
     sd = shading_data(sp, dx, dy, dz, False, True, True, False, tri, b1, b2,
                       sc.tex.tri_object[tri], PF_EMISSION, dist, depths, 0.0)
-    res = eval_shader(sc.svm_ops, sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs,
-                      scratch.cl_light, sd, sc.tex, sc.verts, sc.tris, sc.local)
+    res = eval_shader(sc.mat_prog[m, 0], sc.mat_prog[m, 1], scratch.regs, scratch.cl_light, sd,
+                      by_ref(shader_scene(sc)))
     return res.er, res.eg, res.eb
 
 

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ..jit import kernel
+from ..jit import by_ref, kernel
 from .intersect import SHADOW_SHORTEN, intersect_triangle, offset_scale, prim_corners
 from .shading import shade_point
 from .state import (
@@ -27,6 +27,7 @@ from .state import (
     VIS_SHADOW,
 )
 from .surface import surface_point
+from .svm import shader_scene
 
 # sq.alive values while tracing transparent shadows.
 SHADOW_BLOCKED = 0
@@ -65,6 +66,7 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
     bounces; any other hit blocks it.
     """
     going = 0
+    scene_ref = by_ref(shader_scene(sc))
     for s in range(n_shadow):
         if sq.alive[s] != SHADOW_TRACING:
             continue
@@ -90,8 +92,9 @@ def advance_shadows(n_shadow, prim, sq, sc, cfg, scratch):
         # Light Path sees a shadow ray from the shading point, with the path's bounces and
         # the transparent surfaces passed so far (Cycles' shadow path state).
         dep = sq.depths[s]
-        res = shade_point(sc, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz, sq.travelled[s] + t,
-                          PF_SHADOW, False, (dep[0], dep[1], dep[2], dep[3], dep[4]), 0.0)
+        res = shade_point(sc, scene_ref, cfg, scratch, sp, m, p, b1, b2, dx, dy, dz,
+                          sq.travelled[s] + t, PF_SHADOW, False,
+                          (dep[0], dep[1], dep[2], dep[3], dep[4]), 0.0)
         dep[4] += 1
         sq.contrib[s, 0] *= res.tr
         sq.contrib[s, 1] *= res.tg

@@ -13,7 +13,7 @@ import pytest
 
 from mcengine.kernels.closures.layout import CL_STRIDE, MAX_CLOSURES
 from mcengine.kernels.state import MF_CLOSURES_ONLY
-from mcengine.kernels.svm import ShadingData, eval_closure_rows, eval_shader
+from mcengine.kernels.svm import ShaderScene, ShadingData, eval_closure_rows, eval_shader_by_value
 from mcengine.scene import Link, Material, ShaderNode
 from mcengine.shaders import NO_MESH, NO_TEXTURES, ShaderTable
 
@@ -89,7 +89,8 @@ def test_closure_rows_give_what_the_shader_gives(table):
         for sd in _points(25):
             regs_a, regs_b = table.registers.copy(), table.registers.copy()
             cl_a, cl_b = np.zeros((MAX_CLOSURES, CL_STRIDE)), np.zeros((MAX_CLOSURES, CL_STRIDE))
-            a = eval_shader(table.ops, start, end, regs_a, cl_a, sd, NO_TEXTURES, *NO_MESH)
+            a = eval_shader_by_value(start, end, regs_a, cl_a, sd,
+                                     ShaderScene(table.ops, NO_TEXTURES, *NO_MESH))
             b = eval_closure_rows(table.ops, start, end, regs_b, cl_b, sd)
             assert tuple(a) == tuple(b), name
             assert a.n > 0 or name == "add with holdout", name

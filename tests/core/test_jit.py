@@ -13,10 +13,10 @@ from numba.core import inline_closurecall as inlining
 from numba.core.registry import cpu_target
 
 import mcengine.jit  # noqa: F401  (installs the changes)
-from mcengine.jit import by_ref, deref
+from mcengine.jit import by_ref, deref, field_ref
 from mcengine.kernels import light_tracing, path
-from mcengine.kernels.svm import ShadingData
-from mcengine.shaders import NO_TEXTURES
+from mcengine.kernels.svm import ShaderScene, ShadingData
+from mcengine.shaders import NO_MESH, NO_TEXTURES
 
 
 @njit(_nrt=False)
@@ -51,6 +51,32 @@ def test_a_tuple_passed_by_reference_reads_as_the_value():
     tex = NO_TEXTURES._replace(pixf=np.zeros(5, np.float32))
     assert _through_refs(sd, tex) == sd
     np.testing.assert_array_equal(tex.pixf, np.arange(5))
+
+
+@njit(_nrt=False)
+def _texel_sum(tex_ref):
+    """Called: sums the float texels of the ``TextureData`` it has the address of."""
+    pixf = deref(tex_ref).pixf
+    total = 0.0
+    for k in range(pixf.shape[0]):
+        total += pixf[k]
+    return total
+
+
+@njit(_nrt=False)
+def _through_field(scene):
+    scene_ref = by_ref(scene)
+    return _texel_sum(field_ref(scene_ref, 1)), deref(scene_ref).verts.shape[0]
+
+
+def test_a_field_reference_reads_that_field_of_the_tuple():
+    """``field_ref(ref, 1)`` of a ``ShaderScene`` is the address of its ``tex``: what is
+    read through it is that ``TextureData`` (a wrong index would give another field, and
+    numba would not compile the call)."""
+    tex = NO_TEXTURES._replace(pixf=np.arange(1.0, 5.0, dtype=np.float32))
+    verts, tris, local = NO_MESH
+    scene = ShaderScene(np.zeros((0, 4), np.int32), tex, np.zeros((3, 3)), tris, local)
+    assert _through_field(scene) == (10.0, 3)
 
 
 @njit(inline="always")

@@ -44,7 +44,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ...jit import by_ref, deref, device, function
+from ...jit import by_ref, deref, device, field_ref, function
 from ..colorspace import RGB_TO_Y, luminance  # noqa: F401  (RGB_TO_Y: for the compiler)
 from ..scalar import saturate
 from .ao import ao_node
@@ -69,6 +69,7 @@ from .data import (  # noqa: F401  (what the evaluator reads, for its callers)
     OBJ_TEXSPACE_LOC,
     OBJ_TEXSPACE_SIZE,
     OBJ_VISIBILITY,
+    ShaderScene,
     ShadingData,
     TextureData,
 )
@@ -168,19 +169,24 @@ def convert(regs, a, b, kind):
 
 
 @device
-def eval_row(ops, pc, regs, sd_ref, tex_ref, verts, tris, local):
+def eval_row(ops, pc, regs, sd_ref, scene_ref):
     """One value row: OP_NODE, OP_COPY or OP_CONVERT."""
     op = ops[pc, 0]
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if op == OP_NODE:
+        tex_ref = field_ref(scene_ref, 1)
         if a == _WIREFRAME:         # the nodes that read the triangles themselves
-            wireframe_node(regs, b, c, deref(sd_ref), verts, tris)
+            scene = deref(scene_ref)
+            wireframe_node(regs, b, c, deref(sd_ref), scene.verts, scene.tris)
         elif a == _DPDV:
-            dpdv_node(regs, c, deref(sd_ref), verts, tris)
+            scene = deref(scene_ref)
+            dpdv_node(regs, c, deref(sd_ref), scene.verts, scene.tris)
         elif a == _BEVEL:
-            bevel_node(regs, b, c, deref(sd_ref), deref(tex_ref), verts, tris, local)
+            scene = deref(scene_ref)
+            bevel_node(regs, b, c, deref(sd_ref), scene.tex, scene.verts, scene.tris, scene.local)
         elif a == _AO:
-            ao_node(regs, b, c, deref(sd_ref), deref(tex_ref), verts, tris, local)
+            scene = deref(scene_ref)
+            ao_node(regs, b, c, deref(sd_ref), scene.tex, scene.verts, scene.tris, scene.local)
         else:
             eval_node(np.int64(a), regs, np.int64(b), np.int64(c), sd_ref, tex_ref)   # as the compiler folds
     elif op == OP_COPY:
@@ -191,42 +197,43 @@ def eval_row(ops, pc, regs, sd_ref, tex_ref, verts, tris, local):
 
 
 @function
-def eval_values(ops, start, end, regs, sd_ref, tex_ref, verts, tris, local):
-    """Run value rows [start, end) at the point ``sd_ref`` (by reference, as the texture
-    data): the Height sub-graph of a Bump node, or the output's Displacement; a Bump node in
-    there moves the point again from that point."""
+def eval_values(start, end, regs, sd_ref, scene_ref):
+    """Run value rows [start, end) of the scene's programs at the point ``sd_ref`` (the
+    point and the ``ShaderScene`` by reference): the Height sub-graph of a Bump node, or the
+    output's Displacement; a Bump node in there moves the point again from that point."""
+    ops = deref(scene_ref).ops
     point = sd_ref
     for pc in range(start, end):
         if ops[pc, 0] == OP_BUMP:
             if ops[pc, 1] == BUMP_LEAVE:
                 point = sd_ref
             else:
-                point = by_ref(region_point(ops, pc, regs, deref(sd_ref), deref(tex_ref), verts, tris))
+                point = by_ref(region_point(ops, pc, regs, deref(sd_ref), deref(scene_ref)))
         else:
-            eval_row(ops, pc, regs, point, tex_ref, verts, tris, local)
+            eval_row(ops, pc, regs, point, scene_ref)
 
 
 @device
-def region_point(ops, pc, regs, sd, tex, verts, tris):
+def region_point(ops, pc, regs, sd, scene):
     """The point the rows after ``OP_BUMP`` row pc run at (not ``BUMP_LEAVE``)."""
     axis = ops[pc, 1]
     if axis >= BUMP_UNDISPLACED:
-        return undisplaced_point(sd, verts, tris, regs, ops[pc, 2], axis - BUMP_UNDISPLACED, tex)
-    return bump_point(sd, verts, tris, regs[ops[pc, 2]], axis)
+        return undisplaced_point(sd, scene.verts, scene.tris, regs, ops[pc, 2],
+                                 axis - BUMP_UNDISPLACED, scene.tex)
+    return bump_point(sd, scene.verts, scene.tris, regs[ops[pc, 2]], axis)
 
 
 @function
-def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
-    """Run rows [start, end) of ``ops`` at the shading point ``sd``; a :class:`ShaderResult`.
-    ``verts`` and ``tris`` are the scene's triangles, on which a Bump node moves the point,
-    ``local`` the hierarchies (``subsurface.LocalBVH``) that Bevel and Ambient Occlusion nodes
-    trace (not in ``tex``, which the node functions read through one copy per run,
-    ``jit.by_ref``: that copy would grow by seven arrays)."""
+def eval_shader(start, end, regs, cl, sd, scene_ref):
+    """Run rows [start, end) of the scene's programs at the shading point ``sd``; a
+    :class:`ShaderResult`.  ``scene_ref`` is the address of a :class:`ShaderScene`
+    (``jit.by_ref``), which callers make once per kernel call, not once per point; the node
+    functions take the point and the texture data by reference too."""
     res = NO_RESULT
-    tex_ref = by_ref(tex)     # node functions take the point and the textures by reference
+    ops = deref(scene_ref).ops
     if start < end and ops[start, 0] == OP_BUMP and ops[start, 1] == BUMP_SET_NORMAL:
         surface, b = start + ops[start, 3], ops[start, 2]
-        eval_values(ops, start + 1, surface, regs, by_ref(sd), tex_ref, verts, tris, local)
+        eval_values(start + 1, surface, regs, by_ref(sd), scene_ref)
         sd = with_normal(sd, regs[b], regs[b + 1], regs[b + 2])
         start = surface
     sd_ref = by_ref(sd)
@@ -238,12 +245,24 @@ def eval_shader(ops, start, end, regs, cl, sd, tex, verts, tris, local):
         if op == OP_CLOSURE or op == OP_MIX_WEIGHT:
             res = closure_row(ops, pc, regs, cl, sd, res)
         elif op == OP_BUMP:
-            eval_values(ops, pc + 1, pc + ops[pc, 3], regs,
-                        by_ref(region_point(ops, pc, regs, sd, tex, verts, tris)), tex_ref, verts, tris, local)
+            eval_values(pc + 1, pc + ops[pc, 3], regs,
+                        by_ref(region_point(ops, pc, regs, sd, deref(scene_ref))), scene_ref)
             skip = pc + ops[pc, 3] + 1
         else:
-            eval_row(ops, pc, regs, sd_ref, tex_ref, verts, tris, local)
+            eval_row(ops, pc, regs, sd_ref, scene_ref)
     return res
+
+
+@function
+def eval_shader_by_value(start, end, regs, cl, sd, scene):
+    """``eval_shader`` with the ``ShaderScene`` by value, for callers on the host."""
+    return eval_shader(start, end, regs, cl, sd, by_ref(scene))
+
+
+@device
+def shader_scene(sc):
+    """What the shader evaluator reads of the scene (``state.SceneData``)."""
+    return ShaderScene(sc.svm_ops, sc.tex, sc.verts, sc.tris, sc.local)
 
 
 @device

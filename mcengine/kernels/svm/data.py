@@ -45,6 +45,16 @@ TextureData = namedtuple("TextureData", [
     "pixf",                    # (N,) float32  texels of the float images
 ])
 
+# What the shader evaluator reads of the scene, passed to it by reference (``jit.by_ref``,
+# made once per kernel call: by value, a call would copy these 150-odd machine words).
+ShaderScene = namedtuple("ShaderScene", [
+    "ops",                     # (P, 4) int32   every material's program (``shaders.ShaderTable``)
+    "tex",                     # TextureData
+    "verts",                   # (V, 3) f64     the triangles, on which Bump nodes move the point,
+    "tris",                    # (T, 3) int32
+    "local",                   # subsurface.LocalBVH: what Bevel and AO nodes trace
+])
+
 # Per-object data (TextureData.objects columns).
 OBJ_MATRIX = 0                # 3 x 4 object -> world (row major, world units)
 OBJ_INVERSE = 12              # 3 x 4 world -> object

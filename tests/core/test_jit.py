@@ -63,14 +63,17 @@ def _texel_sum(tex_ref):
     return total
 
 
+_TEX = ShaderScene._fields.index("tex")
+
+
 @njit(_nrt=False)
 def _through_field(scene):
     scene_ref = by_ref(scene)
-    return _texel_sum(field_ref(scene_ref, 1)), deref(scene_ref).verts.shape[0]
+    return _texel_sum(field_ref(scene_ref, _TEX)), deref(scene_ref).verts.shape[0]
 
 
 def test_a_field_reference_reads_that_field_of_the_tuple():
-    """``field_ref(ref, 1)`` of a ``ShaderScene`` is the address of its ``tex``: what is
+    """``field_ref`` of a ``ShaderScene``'s ``tex`` is the address of that field: what is
     read through it is that ``TextureData`` (a wrong index would give another field, and
     numba would not compile the call)."""
     tex = NO_TEXTURES._replace(pixf=np.arange(1.0, 5.0, dtype=np.float32))

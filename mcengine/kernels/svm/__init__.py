@@ -95,6 +95,7 @@ _WIREFRAME = NODES["Wireframe"].code
 _DPDV = NODES["dPdv"].code
 _BEVEL = NODES["Bevel"].code
 _AO = NODES["AmbientOcclusion"].code
+_TEX = ShaderScene._fields.index("tex")      # for jit.field_ref
 
 OP_END = 0
 OP_NODE = 1
@@ -174,7 +175,7 @@ def eval_row(ops, pc, regs, sd_ref, scene_ref):
     op = ops[pc, 0]
     a, b, c = ops[pc, 1], ops[pc, 2], ops[pc, 3]
     if op == OP_NODE:
-        tex_ref = field_ref(scene_ref, 1)
+        tex_ref = field_ref(scene_ref, _TEX)
         if a == _WIREFRAME:         # the nodes that read the triangles themselves
             scene = deref(scene_ref)
             wireframe_node(regs, b, c, deref(sd_ref), scene.verts, scene.tris)

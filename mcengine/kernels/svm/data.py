@@ -46,7 +46,7 @@ TextureData = namedtuple("TextureData", [
 ])
 
 # What the shader evaluator reads of the scene, passed to it by reference (``jit.by_ref``,
-# made once per kernel call: by value, a call would copy these 150-odd machine words).
+# made once per kernel call: by value, every call would copy these 150 machine words).
 ShaderScene = namedtuple("ShaderScene", [
     "ops",                     # (P, 4) int32   every material's program (``shaders.ShaderTable``)
     "tex",                     # TextureData

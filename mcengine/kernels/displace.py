@@ -44,7 +44,8 @@ def displacement_offsets(ops, ranges, results, regs, tex, verts, tris, local, ng
                          False, False, True, True, False, i64(t), u, v,
                          i64(tex.tri_object[t]), i64(0), 0.0,
                          i64(0), i64(0), i64(0), i64(0), i64(0), 0.0, np.uint64(0), 0.0)
-        eval_values(ranges[m, 0], ranges[m, 1], regs, by_ref(sd), scene_ref)
+        # (int64 bounds, as eval_shader passes them: one compiled eval_values for both)
+        eval_values(i64(ranges[m, 0]), i64(ranges[m, 1]), regs, by_ref(sd), scene_ref)
         r = results[m]
         for c in range(3):
             x = regs[r + c]

@@ -47,8 +47,11 @@ from .shaders import (
 )
 
 
-def displace(scene: SceneDescription) -> SceneDescription:
-    """``scene`` with its truly displaced meshes moved (the scene itself when it has none)."""
+def displace(scene: SceneDescription, images: ImageTable | None = None) -> SceneDescription:
+    """``scene`` with its truly displaced meshes moved (the scene itself when it has none).
+
+    ``images``: the scene's images as the kernels read them (``packing.scene_images``), if
+    the caller has loaded them already (they take a second per few 4K images)."""
     g = scene.geometry
     moved = np.array([truly_displaced(m) for m in scene.materials], bool)
     if not len(g.triangles) or not moved.any() or not moved[g.material_index].any():
@@ -79,7 +82,9 @@ def displace(scene: SceneDescription) -> SceneDescription:
     before = dataclasses.replace(g, attributes=attributes, object_texspace=texspace)
 
     normals = _vertex_normals(g, matrix, obj, corner_tri, corner)
-    offsets = _evaluate(scene, before, corner_tri, corner, normals)
+    if images is None:
+        images = ImageTable(scene.images)
+    offsets = _evaluate(scene, before, corner_tri, corner, normals, images)
     shift = np.zeros_like(world)
     shift[vertex] = offsets
     vertices = world + shift
@@ -132,10 +137,10 @@ def _object_normals(g: Geometry, matrix, obj) -> np.ndarray:
     return _unit(n).astype(np.float32)
 
 
-def _evaluate(scene: SceneDescription, g: Geometry, corner_tri, corner, normals) -> np.ndarray:
+def _evaluate(scene: SceneDescription, g: Geometry, corner_tri, corner, normals,
+              images: ImageTable) -> np.ndarray:
     """The displacement vectors at the chosen corners (``kernels.displace``)."""
     layout, attr = pack_attributes(g)
-    images = ImageTable(scene.images)
     ops, ranges, results, init, base = [], [], [], {}, 0
     for m in scene.materials:
         start = len(ops)

@@ -124,11 +124,18 @@ def sampler_code(it) -> int:
     return samplers.get(it.sampler).kernel_code
 
 
-def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
+def scene_images(scene: SceneDescription) -> ImageTable:
+    """The scene's images and its sky textures' images, loaded as the kernels read them."""
+    return ImageTable({**scene.images, **sky_images(scene)})
+
+
+def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | None = None
+               ) -> PackedScene:
     """Pack a scene description into the kernels' arrays (see :class:`PackedScene`).
 
     ``force_effects`` names effects of the plan to switch on although the scene
     does not call for them ("all" for every one): for the benchmark and the tests.
+    ``images`` is the scene's ``scene_images`` if the caller has loaded them already.
     """
     g = scene.geometry
     verts = g.vertices.astype(np.float64)
@@ -147,7 +154,8 @@ def pack_scene(scene: SceneDescription, force_effects=()) -> PackedScene:
     scene_radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
 
     layout, attr = pack_attributes(g)
-    images = ImageTable({**scene.images, **sky_images(scene)})
+    if images is None:
+        images = scene_images(scene)
     shaders = ShaderTable(scene.materials + [scene.world.material()], layout, images.slots)
     world = len(scene.materials)            # the world's program follows the materials'
     start, end = shaders.ranges[world]

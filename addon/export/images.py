@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mcengine.images import unit_floats_to_bytes
 from mcengine.scene import Image
 
 __all__ = ["export_image"]
@@ -68,7 +69,7 @@ def _convert(ctx, image) -> Image | None:
         if alpha == "STRAIGHT":
             alpha = "PREMUL"          # Blender's float buffers hold associated alpha
         return Image(pixels=values, colorspace=colorspace, alpha=alpha)
-    pixels = np.rint(np.clip(values, 0.0, 1.0) * 255.0).astype(np.uint8)
+    pixels = unit_floats_to_bytes(values)
     if is_data:
         colorspace = "data"
     elif settings.name in _LINEAR_SPACES:

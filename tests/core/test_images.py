@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from mcengine.images import ImageTable, load_texels
+from mcengine import images
+from mcengine.images import ImageTable, associate_rgba8, load_texels, unit_floats_to_bytes
 from mcengine.kernels.svm.data import IMG_CHANNELS, IMG_FLAGS, IMG_FLOAT, IMGF_SRGB, IMGF_UNASSOCIATE
 from mcengine.scene import Image, Link, SceneDescription, SceneError, ShaderNode, World
 
@@ -38,6 +39,72 @@ def test_non_finite_float_texels_become_zero():
     px = np.array([[[np.nan, 1, 1, 1], [np.inf, 2, 2, 1], [3, 3, 3, 1]]], np.float32)
     assert load_texels(Image(px, "linear", "PREMUL")).tolist() == [
         [[0, 0, 0, 0], [0, 0, 0, 0], [3, 3, 3, 1]]]
+
+
+def test_bytes_are_associated_as_integer_division_for_every_colour_and_alpha():
+    """Every (colour, alpha) pair, in each colour channel, gives c * a // 255."""
+    c, a = (v.ravel() for v in np.meshgrid(np.arange(256), np.arange(256)))
+    rgba = np.stack([c, 255 - c, c[::-1], a], axis=1).astype(np.uint8).reshape(256, 256, 4)
+    want = rgba.astype(np.int64)
+    want[..., :3] = want[..., :3] * want[..., 3:] // 255
+    associate_rgba8(rgba)
+    np.testing.assert_array_equal(rgba, want)
+
+
+def test_unit_floats_become_the_bytes_numpy_rounds_them_to(monkeypatch):
+    """Blender's float view of a byte image back to its bytes, block by block (here blocks of
+    4 values, the last one short): round(255 clip(v, 0, 1)), ties to even as np.rint; every
+    byte's own value b / 255 and the half-way points between bytes included."""
+    monkeypatch.setattr(images, "_BLOCK_TEXELS", 1)
+    rng = np.random.default_rng(3)
+    v = np.concatenate([np.arange(256) / 255.0, (np.arange(255) + 0.5) / 255.0,
+                        rng.uniform(-1.0, 2.0, 1001)]).astype(np.float32).reshape(-1, 1, 1)
+    want = np.rint(np.clip(v, 0.0, 1.0) * np.float32(255.0)).astype(np.uint8)
+    got = unit_floats_to_bytes(v.copy())
+    assert got.dtype == np.uint8 and got.shape == v.shape
+    np.testing.assert_array_equal(got, want)
+
+
+def _reference_texel(px, channels_in, is_float, alpha, colorspace):
+    """One texel as the load conventions of the module docstring say, written out per texel."""
+    v = [float(x) for x in px] if is_float else [int(x) for x in px]
+    if is_float and not all(np.isfinite(v)):
+        v = [0.0] * channels_in
+    if channels_in == 1:
+        return v
+    one = 1.0 if is_float else 255
+    rgb, a = ((v[:1] * 3, v[1]) if channels_in == 2 else
+              (v[:3], v[3] if channels_in == 4 else one))
+    if alpha == "NONE":
+        a = one
+    elif alpha == "STRAIGHT" and colorspace != "data":
+        rgb = [x * a for x in rgb] if is_float else [x * a // 255 for x in rgb]
+    return rgb + [a]
+
+
+@pytest.mark.parametrize("channels", [1, 2, 3, 4])
+@pytest.mark.parametrize("is_float", [False, True])
+@pytest.mark.parametrize("alpha, colorspace", [("STRAIGHT", "sRGB"), ("STRAIGHT", "data"),
+                                               ("PREMUL", "linear"), ("NONE", "sRGB"),
+                                               ("CHANNEL_PACKED", "sRGB")])
+def test_texels_converted_in_blocks_match_the_conventions_texel_by_texel(
+        monkeypatch, channels, is_float, alpha, colorspace):
+    """Images are converted a block of rows at a time (here 3 rows of 7, a last block of 2):
+    every texel as the conventions give it alone, and the source pixels left unchanged."""
+    monkeypatch.setattr(images, "_BLOCK_TEXELS", 21)
+    rng = np.random.default_rng(channels + 10 * is_float)
+    if is_float:
+        px = rng.uniform(-0.5, 4.0, (8, 7, channels)).astype(np.float32)
+        px[1, 2, 0], px[5, 6, -1], px[7, 0, 0] = np.nan, np.inf, -np.inf
+    else:
+        px = rng.integers(0, 256, (8, 7, channels), dtype=np.uint8)
+    source = px.copy()
+    got = load_texels(Image(px, colorspace, alpha))
+    want = [[_reference_texel(px[y, x], channels, is_float, alpha, colorspace)
+             for x in range(7)] for y in range(8)]
+    assert got.dtype == (np.float32 if is_float else np.uint8)
+    np.testing.assert_array_equal(got, np.array(want, got.dtype))
+    np.testing.assert_array_equal(px, source)
 
 
 def test_image_table_pools_and_flags():

@@ -5,7 +5,9 @@ height field of 1k to 4M triangles in an open three-walled room with an area
 light.  Two sweeps:
 
 * triangles (1k, 10k, 100k, 1M; 4M with ``--full``) at ``--resolution`` (512 x 512);
-* resolutions (256 x 256, 1024 x 1024, 1920 x 1080, 3840 x 2160) at 100k triangles.
+* resolutions (256 x 256, 1024 x 1024, 1920 x 1080, 3840 x 2160) at 100k triangles;
+* images: the 100k scene with 1 and 4 of its surfaces textured by packed 8-bit images of
+  4096 x 4096 texels, at ``--resolution`` (each render loads and converts them).
 
 Every (engine, scene, resolution) is measured in a fresh process, so that its peak
 memory is its own: the process first renders a tiny scene (kernels loaded, as
@@ -34,6 +36,7 @@ triangles, and 4K at 100k triangles with 8 samples, to show that memory does not
 grow with samples (about 30 minutes more).
 
 Run: python benchmarks/bench_scale.py [--full] [--engines mcengine,cycles]
+                                      [--sweeps triangles,resolutions,images]
                                       [--resolution N] [--paths N] [--out DIR]
 """
 from __future__ import annotations
@@ -57,8 +60,11 @@ TRIANGLES = (1_000, 10_000, 100_000, 1_000_000)
 FULL_TRIANGLES = (4_000_000,)
 RESOLUTIONS = ((256, 256), (1024, 1024), (1920, 1080), (3840, 2160))
 RESOLUTION_SWEEP_TRIANGLES = 100_000
+IMAGE_SWEEP = (1, 4)            # textured surfaces, each an image of IMAGE_SIZE^2 texels
+IMAGE_SIZE = 4096
+SWEEPS = ("triangles", "resolutions", "images")
 FULL_4K_SAMPLES = 8
-FIELDS = ("engine", "triangles", "width", "height", "samples", "first_image_s", "export_s",
+FIELDS = ("engine", "triangles", "images", "width", "height", "samples", "first_image_s", "export_s",
           "prepare_s", "bvh_s", "kernels_s", "sync_s", "startup_rest_s", "render_1spp_s",
           "render_s", "mpaths_per_s", "rss_scene_mib", "rss_peak_mib", "render_own_mib",
           "buffers_mib", "estimate_mib")
@@ -74,47 +80,60 @@ def main(argv=None) -> int:
                     help="square resolution of the triangle sweep")
     ap.add_argument("--paths", type=float, default=4e6,
                     help="paths per measured render (sets its samples per pixel)")
+    ap.add_argument("--sweeps", default=",".join(SWEEPS),
+                    help=f"which sweeps to run, of {', '.join(SWEEPS)}")
     ap.add_argument("--out", type=Path, default=REPO / "out" / "bench_scale")
     args = ap.parse_args(argv)
+    sweeps = {w.strip() for w in args.sweeps.split(",") if w.strip()}
+    if not sweeps or sweeps - set(SWEEPS):
+        print(f"bench_scale: --sweeps takes {', '.join(SWEEPS)}", file=sys.stderr)
+        return 2
     engines = [e.strip() for e in args.engines.split(",") if e.strip()]
     if not engines or set(engines) - {"mcengine", "cycles"}:
         print("bench_scale: --engines takes mcengine, cycles or both", file=sys.stderr)
         return 2
 
     tri_sweep = TRIANGLES + (FULL_TRIANGLES if args.full else ())
-    runs = [(t, (args.resolution, args.resolution), None) for t in tri_sweep]
-    runs += [(RESOLUTION_SWEEP_TRIANGLES, r, None) for r in RESOLUTIONS
-             if (RESOLUTION_SWEEP_TRIANGLES, r, None) not in runs]
-    if args.full:
+    square = (args.resolution, args.resolution)
+    # (triangles, textured surfaces, resolution, samples or None: from --paths)
+    runs = [(t, 0, square, None) for t in tri_sweep] if "triangles" in sweeps else []
+    if "resolutions" in sweeps:
+        runs += [(RESOLUTION_SWEEP_TRIANGLES, 0, r, None) for r in RESOLUTIONS
+                 if (RESOLUTION_SWEEP_TRIANGLES, 0, r, None) not in runs]
+    if "images" in sweeps:
+        runs += [(RESOLUTION_SWEEP_TRIANGLES, k, square, None) for k in IMAGE_SWEEP]
+    if args.full and "triangles" in sweeps and "resolutions" in sweeps:
         # 4K with the big scenes, and with 4x the samples (memory must not grow with them).
-        runs += [(t, RESOLUTIONS[-1], None) for t in (1_000_000, 4_000_000)]
-        runs += [(RESOLUTION_SWEEP_TRIANGLES, RESOLUTIONS[-1], FULL_4K_SAMPLES)]
+        runs += [(t, 0, RESOLUTIONS[-1], None) for t in (1_000_000, 4_000_000)]
+        runs += [(RESOLUTION_SWEEP_TRIANGLES, 0, RESOLUTIONS[-1], FULL_4K_SAMPLES)]
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench_scale_") as tmp:
         blends = {}
-        for triangles in sorted({t for t, _r, _s in runs}):
-            path = Path(tmp) / f"scale_{triangles}.blend"
+        for triangles, images in sorted({(t, k) for t, k, _r, _s in runs}):
+            path = Path(tmp) / f"scale_{triangles}_{images}.blend"
             t0 = time.perf_counter()
             done = subprocess.run([sys.executable, str(Path(__file__).with_name("scale_scene.py")),
-                                   str(triangles), str(path)], capture_output=True, text=True)
+                                   str(triangles), str(path), str(images), str(IMAGE_SIZE)],
+                                  capture_output=True, text=True)
             if done.returncode != 0:
                 print(f"bench_scale: building the {triangles}-triangle scene failed:\n"
                       f"{done.stderr[-2000:]}", file=sys.stderr)
                 return 1
-            blends[triangles] = (path, int(done.stdout.split()[-1]))
-            print(f"scene of {blends[triangles][1]:,} triangles built in "
+            blends[triangles, images] = (path, int(done.stdout.split()[-1]))
+            textured = f" with {images} image(s) of {IMAGE_SIZE}^2" if images else ""
+            print(f"scene of {blends[triangles, images][1]:,} triangles{textured} built in "
                   f"{time.perf_counter() - t0:.1f} s", flush=True)
-        for triangles, (w, h), samples in runs:
-            path, count = blends[triangles]
+        for triangles, images, (w, h), samples in runs:
+            path, count = blends[triangles, images]
             samples = samples or max(2, math.ceil(args.paths / (w * h)))
             for engine in engines:
                 row = measure(engine, path, w, h, samples)
-                row["triangles"] = count
+                row["triangles"], row["images"] = count, images
                 rows.append(row)
-                print(f"{engine:9s} {count:>10,} tris {w}x{h} {samples:3d} spp: first image "
-                      f"{row['first_image_s']:.2f} s, {row['mpaths_per_s']:.2f} Mpaths/s, peak "
-                      f"{row['rss_peak_mib']:.0f} MiB (render's own {row['render_own_mib']:.0f})",
-                      flush=True)
+                print(f"{engine:9s} {count:>10,} tris {images} img {w}x{h} {samples:3d} spp: "
+                      f"first image {row['first_image_s']:.2f} s, {row['mpaths_per_s']:.2f} "
+                      f"Mpaths/s, peak {row['rss_peak_mib']:.0f} MiB (render's own "
+                      f"{row['render_own_mib']:.0f})", flush=True)
     args.out.mkdir(parents=True, exist_ok=True)
     write_csv(rows, args.out / "scale.csv")
     plot(rows, args.out / "scale.png", args.resolution)
@@ -252,7 +271,7 @@ def write_csv(rows, path: Path) -> None:
 
 def markdown_table(rows) -> str:
     """The rows as a Markdown table; a dash where a figure does not apply to the engine."""
-    head = ("| engine | triangles | resolution | spp | first image (s) | export (s) | BVH (s) "
+    head = ("| engine | triangles | images | resolution | spp | first image (s) | export (s) | BVH (s) "
             "| Cycles sync (s) | Cycles other start-up, est. (s) | Mpaths/s | peak RSS (MiB) "
             "| above Blender and the scene (MiB) |")
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
@@ -262,7 +281,9 @@ def markdown_table(rows) -> str:
         return "-" if value is None or value == "" else f"{float(value):.2f}"
 
     for r in rows:
-        lines.append(f"| {r['engine']} | {int(r['triangles']):,} | {r['width']}x{r['height']} | "
+        images = int(r.get("images") or 0)
+        lines.append(f"| {r['engine']} | {int(r['triangles']):,} | "
+                     f"{f'{images} x {IMAGE_SIZE}^2' if images else '-'} | {r['width']}x{r['height']} | "
                      f"{r['samples']} | {cell(r, 'first_image_s')} | {cell(r, 'export_s')} | "
                      f"{cell(r, 'bvh_s')} | {cell(r, 'sync_s')} | {cell(r, 'startup_rest_s')} | "
                      f"{cell(r, 'mpaths_per_s')} | {float(r['rss_peak_mib']):.0f} | "
@@ -279,6 +300,7 @@ def plot(rows, path: Path, square: int) -> None:
 
     fig, axes = plt.subplots(2, 2, figsize=(9, 6.5), dpi=80)
     styles = {"mcengine": ("MC Engine", "C0"), "cycles": ("Cycles", "C1")}
+    rows = [r for r in rows if not int(r.get("images") or 0)]      # the untextured scenes
     for engine, (label, color) in styles.items():
         tri = sorted((r for r in rows if r["engine"] == engine and r["width"] == r["height"] == square),
                      key=lambda r: r["triangles"])

@@ -10,7 +10,12 @@ paths bouncing as in the Cornell box.
 The mesh is built with ``foreach_set`` from numpy arrays (``from_pydata`` takes
 minutes for millions of faces) and saved to a temporary .blend, which is not kept.
 
-Run on its own: python benchmarks/scale_scene.py TRIANGLES OUT.blend
+With IMAGES > 0 the ground and then the walls (up to four surfaces) each take their colour
+from an 8-bit image of SIZE x SIZE texels (default 4096), packed into the .blend: smooth
+colour waves with a straight alpha below 1 in places, so a render loads and converts each
+image as it would a photograph's (sRGB decoding, association of the alpha).
+
+Run on its own: python benchmarks/scale_scene.py TRIANGLES OUT.blend [IMAGES [SIZE]]
 """
 from __future__ import annotations
 
@@ -31,9 +36,13 @@ def grid_side(triangles: int) -> int:
     return max(1, round(math.sqrt(triangles / 2.0)))
 
 
-def build(triangles: int, path: Path) -> int:
-    """Write the scene with about ``triangles`` ground triangles to ``path``; returns the
-    total triangle count (ground and walls)."""
+MAX_IMAGES = 4          # the ground and the three walls
+
+
+def build(triangles: int, path: Path, images: int = 0, image_size: int = 4096) -> int:
+    """Write the scene with about ``triangles`` ground triangles (and ``images`` textured
+    surfaces, see the module docstring) to ``path``; returns the total triangle count
+    (ground and walls)."""
     sys.path.insert(0, str(REPO / "blend_scenes"))
     import _common as c
     import bpy
@@ -52,11 +61,54 @@ def build(triangles: int, path: Path) -> int:
     c.add_quad(scene, "BackWall", [(-h, h, 0), (h, h, 0), (h, h, 2), (-h, h, 2)], white)
     c.add_quad(scene, "LeftWall", [(-h, -h, 0), (-h, h, 0), (-h, h, 2), (-h, -h, 2)], red)
     c.add_quad(scene, "RightWall", [(h, -h, 0), (h, -h, 2), (h, h, 2), (h, h, 0)], green)
+    surfaces = [white, white, red, green]           # ground, back, left and right walls
+    if images:
+        _ground_uvs(ground, n)
+        for k in range(min(images, MAX_IMAGES)):
+            surfaces[k] = _textured(bpy, c, f"Textured {k}", _image(bpy, f"waves {k}", image_size, k))
+        ground.materials[0] = surfaces[0]
+        for wall, material in zip(("BackWall", "LeftWall", "RightWall"), surfaces[1:]):
+            bpy.data.objects[wall].data.materials[0] = material
     c.add_light(scene, "AreaLight", "AREA", 200.0, (0.0, 0.0, 3.0), shape="SQUARE", size=1.0)
     c.add_camera(scene, (0.0, -6.5, 3.0), (0.0, 0.0, 0.3), lens_mm=35.0)
     bpy.context.view_layer.update()
     bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=False, copy=True)
     return 2 * n * n + 6
+
+
+def _ground_uvs(mesh, n: int) -> None:
+    """A UV map spanning the ground's grid once (the walls keep Blender's default UVs)."""
+    side = np.linspace(0.0, 1.0, n + 1, dtype=np.float32)
+    u, v = np.meshgrid(side, side, indexing="xy")
+    uv = np.stack([u, v], axis=-1).reshape(-1, 2)
+    corners = np.empty(len(mesh.loops), np.int32)
+    mesh.loops.foreach_get("vertex_index", corners)
+    mesh.uv_layers.new(name="UVMap").data.foreach_set("uv", uv[corners].reshape(-1))
+
+
+def _image(bpy, name: str, size: int, k: int):
+    """A packed 8-bit RGBA image of smooth colour waves (``k`` shifts their phase)."""
+    t = np.linspace(0.0, 2.0 * math.pi, size, dtype=np.float32)
+    u, v = np.meshgrid(t, t, indexing="xy")
+    rgba = np.empty((size, size, 4), np.float32)
+    for ch in range(3):
+        rgba[..., ch] = 0.5 + 0.4 * np.sin(3.0 * u + 2.0 * ch + k) * np.cos(2.0 * v - ch)
+    rgba[..., 3] = np.clip(1.2 + 0.5 * np.sin(5.0 * v + k), 0.0, 1.0)
+    image = bpy.data.images.new(name, size, size, alpha=True)
+    image.pixels.foreach_set(rgba.reshape(-1))
+    image.pack()
+    return image
+
+
+def _textured(bpy, c, name: str, image):
+    """A Diffuse BSDF whose colour is ``image`` at the surface's UV map."""
+    material, tree, output = c._new_material(name)
+    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Roughness"].default_value = 0.0
+    node = c.image_texture(tree, image)
+    tree.links.new(node.outputs["Color"], bsdf.inputs["Color"])
+    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    return material
 
 
 def _height_field(bpy, n: int):
@@ -82,6 +134,6 @@ def _height_field(bpy, n: int):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if not 3 <= len(sys.argv) <= 5:
         sys.exit(__doc__.strip().splitlines()[-1])
-    print(build(int(sys.argv[1]), Path(sys.argv[2])))
+    print(build(int(sys.argv[1]), Path(sys.argv[2]), *(int(a) for a in sys.argv[3:])))

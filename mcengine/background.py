@@ -21,7 +21,6 @@ renderer samples the world from the map it holds and weighs by that map's pdf.
 """
 from __future__ import annotations
 
-import hashlib
 import math
 import os
 import threading
@@ -29,6 +28,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .digest import digest
 from .kernels.background import bake_background
 from .kernels.state import CFG_SIZE, CFG_WORLD_SHADER, alloc_scratch
 from .kernels.svm.data import IMG_CHANNELS, IMG_FLOAT, IMG_HEIGHT, IMG_OFFSET, IMG_WIDTH
@@ -101,13 +101,7 @@ def _digest(sc, world, slots, registers, size) -> bytes:
         pool = sc.tex.pixf if row[IMG_FLOAT] else sc.tex.pix8
         count = int(row[IMG_WIDTH] * row[IMG_HEIGHT] * row[IMG_CHANNELS])
         parts += [row, pool[row[IMG_OFFSET]:row[IMG_OFFSET] + count]]
-    h = hashlib.blake2b(digest_size=32)
-    for array in parts:
-        array = np.ascontiguousarray(array)
-        h.update(f"{array.dtype}{array.shape}".encode())
-        if array.size:
-            h.update(memoryview(array).cast("B"))
-    return h.digest()
+    return digest(parts)
 
 
 def bake_world(sc, cfg, out) -> None:

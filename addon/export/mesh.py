@@ -124,6 +124,9 @@ class CornerTable:
         return self.table[self.index[a0:a1]]
 
 
+_UNSEEN = object()
+
+
 class MeshCollector:
     """Collects mesh instances during the depsgraph walk, then builds the Geometry.
 
@@ -154,6 +157,9 @@ class MeshCollector:
         self._terminators: dict[tuple, list] = {}
         self._visibility: dict[tuple, list] = {}
         self._light_sets: dict[tuple, list] = {}    # (receiver set, light sets) per instance
+        # What the instances of one object under one instancer share (``_source``), by
+        # (object, its data, instancer) address; None: not rendered.
+        self._sources: dict[tuple, tuple | None] = {}
         # Per geometry object, after geometry(): (tag, (first vertex, count), LocalMesh, slots, matrix).
         self.layout: list = []
         # Names of the objects with settings the renderer ignores, by feature (see _OBJECT_NOTES).
@@ -161,6 +167,12 @@ class MeshCollector:
 
     def add(self, inst, name: str, tag=None) -> None:
         """Register one depsgraph instance (non-mesh data is ignored or noted).
+
+        What an instance shares with every other instance of its object under the same
+        instancer (its mesh, material slots, Object Info but the random id, passes, ray
+        visibility, light sets) is worked out for the first of them only
+        (``_source``): a scatter of 10,000 instances took 52 us each, nearly all of it
+        reading the same object settings again.
 
         Parameters
         ----------
@@ -171,11 +183,37 @@ class MeshCollector:
             Returned with the instance's place in the geometry (``layout``).
         """
         ob = inst.object
+        parent = inst.parent if inst.is_instance else None
+        data = ob.data
+        source_key = (ob.as_pointer(), data.as_pointer() if data is not None else 0,
+                      parent.as_pointer() if parent is not None else 0)
+        source = self._sources.get(source_key, _UNSEEN)
+        if source is _UNSEEN:
+            source = self._sources[source_key] = self._source(inst)
+        if source is None:
+            return
+        key, info_tail, passes, terminator, visibility, light_sets = source
+        self._matrices[key].append(np.array(inst.matrix_world, np.float64))
+        self._names[key].append(name)
+        random_id = inst.random_id if inst.is_instance else object_random_id(ob.name)
+        self._infos[key].append([float(random_id & 0xFFFFFFFF), *info_tail])
+        self._passes[key].append(passes)
+        self._tags[key].append(tag)
+        self._terminators[key].append(terminator)
+        self._visibility[key].append(visibility)
+        self._light_sets[key].append(light_sets)
+
+    def _source(self, inst):
+        """What the instances of ``inst``'s object under its instancer share: (mesh key,
+        Object Info after the random id, pass info, shadow terminator offsets, ray
+        visibility, light sets), or None when its data is not rendered (noted if it is
+        unsupported)."""
+        ob = inst.object
         if ob.type in _UNSUPPORTED_DATA:
             self._note(_UNSUPPORTED_DATA[ob.type], ob.name)
-            return
+            return None
         if not isinstance(ob.data, bpy.types.Mesh):
-            return
+            return None
         if getattr(ob, "is_shadow_catcher", False):
             self._note("shadow catcher", ob.name)
         if any(ps.settings.render_type == "PATH" for ps in getattr(ob, "particle_systems", ())):
@@ -191,18 +229,12 @@ class MeshCollector:
             self._matrices[key], self._names[key], self._infos[key] = [], [], []
             self._passes[key], self._tags[key], self._terminators[key] = [], [], []
             self._visibility[key], self._light_sets[key] = [], []
-        if self._meshes[key] is not None:
-            self._matrices[key].append(np.array(inst.matrix_world, np.float64))
-            self._names[key].append(name)
-            random_id = inst.random_id if inst.is_instance else object_random_id(ob.name)
-            self._infos[key].append([float(random_id & 0xFFFFFFFF), float(ob.pass_index),
-                                     *(float(c) for c in ob.color)])
-            self._passes[key].append(object_pass_info(ob, self._holdout(inst)))
-            self._tags[key].append(tag)
-            self._terminators[key].append((ob.shadow_terminator_geometry_offset,
-                                           ob.shadow_terminator_shading_offset))
-            self._visibility[key].append(self._ray_visibility(inst))
-            self._light_sets[key].append(
+        if self._meshes[key] is None:
+            return None
+        return (key, (float(ob.pass_index), *(float(c) for c in ob.color)),
+                object_pass_info(ob, self._holdout(inst)),
+                (ob.shadow_terminator_geometry_offset, ob.shadow_terminator_shading_offset),
+                self._ray_visibility(inst),
                 (self._links.receiver_set(ob), self._links.light_sets(ob)) if self._links
                 else (0, LIGHT_SETS_ALL))
 

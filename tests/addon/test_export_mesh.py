@@ -305,6 +305,27 @@ def test_ray_visibility_is_exported_per_object_and_instance(scene, fake_session)
     assert not [w for w in desc.warnings if "visib" in w.lower()]
 
 
+def test_instances_of_one_object_keep_their_own_instancers_settings(scene, fake_session):
+    """One object rendered as itself and instanced by two empties: what the instances share
+    is read once per object and instancer (MeshCollector._source), so each entry keeps
+    its instancer's Ray Visibility, and each instance its own random id."""
+    assets = bpy.data.collections.new("Assets")
+    scene.collection.children.link(assets)               # "Tri" renders as itself too
+    new_mesh_object("Tri", TRI, [(0, 1, 2)], collection=assets).visible_glossy = False
+    for name, switch in (("A", "visible_diffuse"), ("B", "visible_camera"), ("C", "visible_camera")):
+        empty = bpy.data.objects.new(name, None)
+        empty.instance_type, empty.instance_collection = "COLLECTION", assets
+        setattr(empty, switch, False)
+        scene.collection.objects.link(empty)
+    g = export_scene(fake_session).geometry
+    visibility = dict(zip(g.object_names, g.visibility().tolist()))
+    assert visibility == {"Tri": VIS_ALL & ~VIS_GLOSSY,
+                          "A/Tri": VIS_ALL & ~(VIS_GLOSSY | VIS_DIFFUSE),
+                          "B/Tri": VIS_ALL & ~(VIS_GLOSSY | VIS_CAMERA),
+                          "C/Tri": VIS_ALL & ~(VIS_GLOSSY | VIS_CAMERA)}
+    assert len(set(g.object_info[:, 0].tolist())) == 4
+
+
 def test_each_objects_shadow_terminator_offsets_are_exported(scene, fake_session):
     """Geometry and Shading Offset per object (what they render: test_bump_nodes.py)."""
     new_mesh_object("Default", TRI, [(0, 1, 2)])

@@ -4,7 +4,7 @@ import pytest
 
 from mcengine import images
 from mcengine.images import ImageTable, associate_rgba8, load_texels, unit_floats_to_bytes
-from mcengine.kernels.svm.data import IMG_CHANNELS, IMG_FLAGS, IMG_FLOAT, IMGF_SRGB, IMGF_UNASSOCIATE
+from mcengine.kernels.svm.data import IMG_CHANNELS, IMG_FLAGS, IMG_FLOAT, IMG_OFFSET, IMGF_SRGB, IMGF_UNASSOCIATE
 from mcengine.scene import Image, Link, SceneDescription, SceneError, ShaderNode, World
 
 
@@ -117,6 +117,20 @@ def test_image_table_pools_and_flags():
     assert table.info[:, IMG_CHANNELS].tolist() == [4, 1, 4]
     assert table.info[:, IMG_FLAGS].tolist() == [IMGF_SRGB | IMGF_UNASSOCIATE, 0, 0]
     assert table.nbytes == table.pix8.nbytes + table.pixf.nbytes
+
+
+def test_texels_in_the_pool_after_an_odd_sized_image_are_converted_alike():
+    """An RGBA image after a one-channel image of 9 texels starts at a byte offset that is
+    no multiple of 4: its words are unaligned, its texels the same as loaded alone."""
+    px = np.random.default_rng(5).integers(0, 256, (5, 7, 4), dtype=np.uint8)
+    table = ImageTable({"grey": Image(np.full((3, 3, 1), 7, np.uint8)), "straight": Image(px),
+                        "none": Image(px, "sRGB", "NONE")})
+    start = table.info[1, IMG_OFFSET]
+    assert start % 4 == 1
+    for k, alpha in ((1, "STRAIGHT"), (2, "NONE")):
+        offset = table.info[k, IMG_OFFSET]
+        np.testing.assert_array_equal(table.pix8[offset:offset + px.size].reshape(px.shape),
+                                      load_texels(Image(px, "sRGB", alpha)))
 
 
 def test_images_and_world_graph_survive_save_and_load(tmp_path):

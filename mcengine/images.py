@@ -134,8 +134,10 @@ def unit_floats_to_bytes(values: np.ndarray) -> np.ndarray:
     """The bytes round(255 v) of float32 values v clipped to [0, 1] (Blender's byte buffer
     from its float view b / 255, ties to even as ``np.rint``), as a new uint8 array of the
     same shape; ``values`` is overwritten.  Block by block in the cache, the rounding done
-    by adding 2^23 (the integer is then the float's low mantissa bits): numpy's clip,
-    rint and float-to-uint8 cast took about 0.35 s for a 4096 x 4096 RGBA image."""
+    by adding 2^23 (the integer is then the float's low mantissa bits): 0.07 s for a 4096 x
+    4096 RGBA image, where numpy's clip, rint and cast of the whole array took 0.15 s on
+    warm memory and over a second in a fresh Blender process (three temporaries the size of
+    the float image, each new memory there)."""
     flat = values.reshape(-1)
     out = np.empty(flat.shape, np.uint8)
     step = 4 * _BLOCK_TEXELS

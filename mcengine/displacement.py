@@ -51,7 +51,7 @@ def displace(scene: SceneDescription, images: ImageTable | None = None) -> Scene
     """``scene`` with its truly displaced meshes moved (the scene itself when it has none).
 
     ``images``: the scene's images as the kernels read them (``packing.scene_images``), if
-    the caller has loaded them already (they take a second per few 4K images)."""
+    the caller has loaded them already (not loaded twice: 0.06 s per 4096 x 4096 image)."""
     g = scene.geometry
     moved = np.array([truly_displaced(m) for m in scene.materials], bool)
     if not len(g.triangles) or not moved.any() or not moved[g.material_index].any():

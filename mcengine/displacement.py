@@ -45,6 +45,7 @@ from .shaders import (
     compile_displacement,
     truly_displaced,
 )
+from .vectors import cross, lengths
 
 
 def displace(scene: SceneDescription, images: ImageTable | None = None) -> SceneDescription:
@@ -121,7 +122,7 @@ def _vertex_normals(g: Geometry, matrix, obj, corner_tri, corner) -> np.ndarray:
         n = np.asarray(exported, np.float64)[corner_tri, corner]
         inverse_t = np.linalg.inv(matrix[:, :3, :3]).transpose(0, 2, 1)
         n = np.einsum("vij,vj->vi", inverse_t[obj[corner_tri]], n)
-    length = np.linalg.norm(n, axis=1, keepdims=True)
+    length = lengths(n)[:, None]
     return np.ascontiguousarray(n / np.where(length > 0.0, length, 1.0))
 
 
@@ -182,7 +183,7 @@ def _smooth(g: Geometry) -> np.ndarray:
 
 
 def _unit(v):
-    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    length = lengths(v)[..., None]
     return v / np.where(length > 0.0, length, 1.0)
 
 
@@ -196,12 +197,12 @@ def _recomputed_normals(vertices, tris, normals, smooth, recompute, frames=None)
         return out
     own = tris[recompute]
     p = vertices[own]
-    face = _unit(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
+    face = _unit(cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
     local = vertices if frames is None else (
         np.einsum("vij,vj->vi", frames[0][:, :3, :3], vertices) + frames[0][:, :3, 3])
     q = local[own]
     summed = np.zeros((len(vertices), 3))
-    local_face = _unit(np.cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]))
+    local_face = _unit(cross(q[:, 1] - q[:, 0], q[:, 2] - q[:, 0]))
     for k in range(3):
         np.add.at(summed, own[:, k], local_face)
     vertex_normal = _unit(summed)

@@ -105,6 +105,7 @@ from .passes import kernel_data, motion_corners, world_to_raster
 from .scene import DEFAULT_TERMINATOR_OFFSETS, SceneDescription
 from .shaders import AttributeLayout, ShaderTable
 from .sky import sky_images, sun_guide
+from .vectors import cross, lengths
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
@@ -379,10 +380,10 @@ def areas_and_normals(verts, tris, block: int = 1 << 16):
     tri_normal = np.empty((t, 3))
     for a in range(0, t, block):
         p = verts[tris[a:a + block]]
-        cross = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        length = np.linalg.norm(cross, axis=1)
+        n = cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        length = lengths(n)
         tri_area[a:a + block] = 0.5 * length
-        tri_normal[a:a + block] = cross / np.where(length > 0, length, 1.0)[:, None]
+        tri_normal[a:a + block] = n / np.where(length > 0, length, 1.0)[:, None]
     return tri_area, tri_normal
 
 

@@ -45,6 +45,7 @@ from mcengine.shaders import (
     SMOOTH_ATTRIBUTE,
     VERTEX_NORMAL_ATTRIBUTE,
 )
+from mcengine.vectors import cross, lengths
 
 from .settings import hash_uint2
 
@@ -474,7 +475,7 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
     pos = (np.matmul(mesh.vertices[None], lin.transpose(0, 2, 1)) + m[:, None, :3, 3]) * unit_scale
     # Rows of the cofactor matrix cof(M) = det(M) M^-T, from the columns a, b, c.
     a, b, c = lin[:, :, 0], lin[:, :, 1], lin[:, :, 2]
-    cof = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=2)
+    cof = np.stack([cross(b, c), cross(c, a), cross(a, b)], axis=2)
     det = np.einsum("ni,ni->n", a, cof[:, :, 0])
     flip = det < 0
     # sign(det) * cof is M^-T up to a positive factor, which renormalising removes.
@@ -525,12 +526,12 @@ def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0):
 
 def _unit_normals(normals, pos, tris):
     """Normalise (T, 3, 3) corner normals; zero ones become the geometric normal."""
-    length = np.linalg.norm(normals, axis=2, keepdims=True)
+    length = lengths(normals)[..., None]
     bad = length[..., 0] == 0
     if np.any(bad):
         p = pos[tris]
-        ng = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        ng_len = np.linalg.norm(ng, axis=1, keepdims=True)
+        ng = cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        ng_len = lengths(ng)[:, None]
         ng = np.where(ng_len > 0, ng / np.where(ng_len > 0, ng_len, 1.0), [0.0, 0.0, 1.0])
         normals = np.where(bad[..., None], ng[:, None, :], normals)
         length = np.where(bad[..., None], 1.0, length)
@@ -590,8 +591,8 @@ def _shading_normals(me, vertices, corners, triangles, polygons) -> CornerTable:
     if domain == "POINT":
         return CornerTable(vertex, triangles)
     p = vertices.astype(np.float64)[triangles]
-    flat = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    length = np.linalg.norm(flat, axis=1, keepdims=True)
+    flat = cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = lengths(flat)[:, None]
     polygon = _get(me.polygon_normals, "vector", np.float32, len(me.polygons) * 3).reshape(-1, 3)
     flat = np.where(length > 0.0, flat / np.where(length > 0.0, length, 1.0), polygon[polygons])
     own = _face_corners(np.arange(len(triangles)))

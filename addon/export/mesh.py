@@ -121,8 +121,9 @@ class CornerTable:
     index: np.ndarray
 
     def corners(self, a0: int, a1: int) -> np.ndarray:
-        """(a1 - a0, 3, C) float32 values of triangles a0..a1-1."""
-        return self.table[self.index[a0:a1]]
+        """(a1 - a0, 3, C) float32 values of triangles a0..a1-1 (``np.take``: a third of the
+        time of fancy indexing on rows of a few floats)."""
+        return np.take(self.table, self.index[a0:a1], axis=0)
 
 
 _UNSEEN = object()
@@ -360,7 +361,7 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         # from attribute arrays that have.
         loops = _get(me.loop_triangles, "loops", np.int32, t * 3)
         polygons = _get(me.loop_triangle_polygons, "value", np.int32, t)
-        triangles = _corner_vertices(me)[loops].reshape(t, 3)
+        triangles = np.take(_corner_vertices(me), loops).reshape(t, 3)
         vertices = _get(me.vertices, "co", np.float32, len(me.vertices) * 3).reshape(-1, 3)
         corners = loops.reshape(t, 3)
         normals = _shading_normals(me, vertices, corners, triangles, polygons)

@@ -14,8 +14,9 @@ The last map is kept for the next render whose world bakes from the same inputs
 (``world_map``): re-renders, animation frames and the viewport's restarts
 after a camera or material edit skip the bake, as they skip the BVH build
 (``accel_cache``).  The inputs are recognised by a hash (``digest``: SHA-256 on a
-thread pool, 47 ms for a 4096 x 2048 float image) of the world's program, its registers, the images its nodes read and the map's
-size (the camera and the objects only when one of the world's nodes can see them).
+thread pool, 47 ms for a 4096 x 2048 float image) of the world's program, its
+registers, the images its nodes read and the map's size (the camera and the objects
+only when one of the world's nodes can see them).
 A map kept by mistake could only change the noise, never the mean: the
 renderer samples the world from the map it holds and weighs by that map's pdf.
 """

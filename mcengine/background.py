@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -33,6 +32,7 @@ from .digest import digest
 from .kernels.background import bake_background
 from .kernels.state import CFG_SIZE, CFG_WORLD_SHADER, alloc_scratch
 from .kernels.svm.data import IMG_CHANNELS, IMG_FLOAT, IMG_HEIGHT, IMG_OFFSET, IMG_WIDTH
+from .parallel import map_threads
 from .sky import node_image
 
 DEFAULT_MAP = (1024, 512)     # Automatic, without an Environment Texture
@@ -112,13 +112,8 @@ def bake_world(sc, cfg, out) -> None:
     h = out.shape[0]
     bands = max(1, min(os.cpu_count() or 1, h))
     edges = [h * k // bands for k in range(bands + 1)]
-    if bands == 1:
-        bake_background(sc, cfg, alloc_scratch(sc), out, 0, h)
-        return
-    with ThreadPoolExecutor(max_workers=bands, thread_name_prefix="mcengine-bake") as pool:
-        for done in [pool.submit(bake_background, sc, cfg, alloc_scratch(sc), out, edges[k],
-                                 edges[k + 1]) for k in range(bands)]:
-            done.result()
+    map_threads(lambda k: bake_background(sc, cfg, alloc_scratch(sc), out, edges[k],
+                                          edges[k + 1]), range(bands))
 
 
 def importance_map(radiance: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

@@ -4,17 +4,18 @@ triangles or the same world are recognised by their bytes, whatever object holds
 
 SHA-256, because these CPUs hash it in hardware (SHA extensions): a 4096 x 2048 float
 RGBA image (128 MB) took 86 ms where BLAKE2b took 174 ms.  Arrays of more than
-``SPLIT_BYTES`` are hashed in ``PARTS`` parts on a thread pool (hashlib releases the
-GIL), the parts' digests then hashed in order: a two-level hash tree, as strong as
+``SPLIT_BYTES`` are hashed in ``PARTS`` parts on threads (``parallel.map_threads``:
+hashlib releases the GIL), the parts' digests then hashed in order: a two-level hash tree, as strong as
 SHA-256 itself; the parts depend on the array's size only, so the same bytes give the
 same digest on any machine.
 """
 from __future__ import annotations
 
 import hashlib
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+
+from .parallel import map_threads
 
 __all__ = ["digest"]
 
@@ -36,7 +37,6 @@ def digest(arrays) -> bytes:
             continue
         step = -(-data.nbytes // PARTS)
         parts = [data[a:a + step] for a in range(0, data.nbytes, step)]
-        with ThreadPoolExecutor(thread_name_prefix="mcengine-digest") as pool:
-            for part in pool.map(lambda p: hashlib.sha256(p).digest(), parts):
-                h.update(part)
+        for part in map_threads(lambda p: hashlib.sha256(p).digest(), parts):
+            h.update(part)
     return h.digest()

@@ -101,6 +101,7 @@ from .kernels.svm import (
     OP_NODE,
     TextureData,
 )
+from .parallel import map_threads
 from .passes import kernel_data, motion_corners, world_to_raster
 from .scene import DEFAULT_TERMINATOR_OFFSETS, SceneDescription
 from .shaders import AttributeLayout, ShaderTable
@@ -371,19 +372,22 @@ def pack_objects(g) -> np.ndarray:
 def areas_and_normals(verts, tris, block: int = 1 << 16):
     """Area and unit geometric normal of every triangle, (T,) and (T, 3) float64.
 
-    Computed in blocks of triangles: whole-array float64 temporaries (the corners
-    alone are 72 bytes per triangle) would cost more in page faults than the
-    arithmetic, and would set the peak memory of large scenes.
+    Computed in blocks of triangles, on threads (``parallel.map_threads``): whole-array
+    float64 temporaries (the corners alone are 72 bytes per triangle) would cost more in
+    page faults than the arithmetic, and would set the peak memory of large scenes.
     """
     t = len(tris)
     tri_area = np.empty(t)
     tri_normal = np.empty((t, 3))
-    for a in range(0, t, block):
+
+    def one_block(a):
         p = np.take(verts, tris[a:a + block], axis=0)     # verts[tris], 3x faster
         n = cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
         length = lengths(n)
         tri_area[a:a + block] = 0.5 * length
         tri_normal[a:a + block] = n / np.where(length > 0, length, 1.0)[:, None]
+
+    map_threads(one_block, range(0, t, block))
     return tri_area, tri_normal
 
 

@@ -1,0 +1,26 @@
+"""Host work split over the machine's cores: numpy's loops, hashlib and the compiled kernels
+release the GIL, so independent pieces of a large job run in parallel on threads.
+
+``map_threads`` is the one thread pool of the host's one-off work (the render's own
+workers are ``session.py``'s): hashing the parts of a large array (``digest``), baking the
+world's map in bands of rows (``background``), and the per-triangle blocks of packing and
+of the export.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+__all__ = ["map_threads"]
+
+
+def map_threads(function, items) -> list:
+    """[function(item) for item in items], on as many threads as there are cores (one item
+    each at a time, in order of the items); on one core, or for one item, in this thread.
+    An exception in any call is raised here, after the others have finished."""
+    items = list(items)
+    workers = min(os.cpu_count() or 1, len(items))
+    if workers < 2:
+        return [function(item) for item in items]
+    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="mcengine-host") as pool:
+        return list(pool.map(function, items))

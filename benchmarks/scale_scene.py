@@ -13,7 +13,9 @@ minutes for millions of faces) and saved to a temporary .blend, which is not kep
 With IMAGES > 0 the ground and then the walls (up to four surfaces) each take their colour
 from an 8-bit image of SIZE x SIZE texels (default 4096), packed into the .blend: smooth
 colour waves with a straight alpha below 1 in places, so a render loads and converts each
-image as it would a photograph's (sRGB decoding, association of the alpha).
+image as it would a photograph's (sRGB decoding, association of the alpha). The ground's
+UV map spans its image once; the walls have none (their colour is the texel at UV (0, 0),
+but their images are loaded whole all the same).
 
 Run on its own: python benchmarks/scale_scene.py TRIANGLES OUT.blend [IMAGES [SIZE]]
 """
@@ -65,7 +67,7 @@ def build(triangles: int, path: Path, images: int = 0, image_size: int = 4096) -
     if images:
         _ground_uvs(ground, n)
         for k in range(min(images, MAX_IMAGES)):
-            surfaces[k] = _textured(bpy, c, f"Textured {k}", _image(bpy, f"waves {k}", image_size, k))
+            surfaces[k] = _textured(c, f"Textured {k}", _image(bpy, f"waves {k}", image_size, k))
         ground.materials[0] = surfaces[0]
         for wall, material in zip(("BackWall", "LeftWall", "RightWall"), surfaces[1:]):
             bpy.data.objects[wall].data.materials[0] = material
@@ -77,7 +79,7 @@ def build(triangles: int, path: Path, images: int = 0, image_size: int = 4096) -
 
 
 def _ground_uvs(mesh, n: int) -> None:
-    """A UV map spanning the ground's grid once (the walls keep Blender's default UVs)."""
+    """A UV map spanning the ground's grid once."""
     side = np.linspace(0.0, 1.0, n + 1, dtype=np.float32)
     u, v = np.meshgrid(side, side, indexing="xy")
     uv = np.stack([u, v], axis=-1).reshape(-1, 2)
@@ -100,14 +102,12 @@ def _image(bpy, name: str, size: int, k: int):
     return image
 
 
-def _textured(bpy, c, name: str, image):
+def _textured(c, name: str, image):
     """A Diffuse BSDF whose colour is ``image`` at the surface's UV map."""
-    material, tree, output = c._new_material(name)
-    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    bsdf.inputs["Roughness"].default_value = 0.0
-    node = c.image_texture(tree, image)
-    tree.links.new(node.outputs["Color"], bsdf.inputs["Color"])
-    tree.links.new(bsdf.outputs["BSDF"], output.inputs["Surface"])
+    material = c.node_material(name, "ShaderNodeBsdfDiffuse", roughness=0.0)
+    tree = material.node_tree
+    bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfDiffuse")
+    tree.links.new(c.image_texture(tree, image).outputs["Color"], bsdf.inputs["Color"])
     return material
 
 

@@ -2,7 +2,7 @@
 
 Scenes (benchmarks/scale_scene.py, written to a temporary folder) hold a smooth
 height field of 1k to 4M triangles in an open three-walled room with an area
-light.  Two sweeps:
+light.  Three sweeps (``--sweeps`` chooses):
 
 * triangles (1k, 10k, 100k, 1M; 4M with ``--full``) at ``--resolution`` (512 x 512);
 * resolutions (256 x 256, 1024 x 1024, 1920 x 1080, 3840 x 2160) at 100k triangles;

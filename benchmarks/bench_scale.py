@@ -1,4 +1,4 @@
-"""How MC Engine and Cycles scale with triangles and pixels: start-up, speed and memory.
+"""How MC Engine and Cycles scale with triangles, pixels and images: start-up, speed and memory.
 
 Scenes (benchmarks/scale_scene.py, written to a temporary folder) hold a smooth
 height field of 1k to 4M triangles in an open three-walled room with an area

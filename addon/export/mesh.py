@@ -127,9 +127,6 @@ class CornerTable:
         return np.take(self.table, self.index[a0:a1], axis=0)
 
 
-_UNSEEN = object()
-
-
 class MeshCollector:
     """Collects mesh instances during the depsgraph walk, then builds the Geometry.
 
@@ -190,9 +187,9 @@ class MeshCollector:
         data = ob.data
         source_key = (ob.as_pointer(), data.as_pointer() if data is not None else 0,
                       parent.as_pointer() if parent is not None else 0)
-        source = self._sources.get(source_key, _UNSEEN)
-        if source is _UNSEEN:
-            source = self._sources[source_key] = self._source(inst)
+        if source_key not in self._sources:
+            self._sources[source_key] = self._source(inst)
+        source = self._sources[source_key]
         if source is None:
             return
         key, info_tail, passes, terminator, visibility, light_sets = source

@@ -8,6 +8,7 @@ import pytest
 
 from mcengine.kernels.state import VIS_ALL, VIS_CAMERA, VIS_DIFFUSE, VIS_GLOSSY, VIS_SHADOW, VIS_TRANSMISSION
 from mcengine.shaders import DEFAULT_COLOR_ATTRIBUTE
+from mcengine.tessellation import corner_triangles
 
 from .helpers import CUBE_FACES, CUBE_VERTS, export_scene, new_mesh_object
 
@@ -111,6 +112,84 @@ def test_shading_normals_equal_blender_corner_normals(scene, fake_session, shadi
     me.corner_normals.foreach_get("vector", corner)
     g = export_scene(fake_session).geometry
     np.testing.assert_allclose(g.normals.reshape(-1, 3), corner.reshape(-1, 3)[loops], atol=1e-6)
+
+
+def _blender_triangles(me):
+    """Blender's own triangles of ``me``: (T * 3,) corners and (T,) faces."""
+    t = len(me.loop_triangles)
+    loops, faces = np.empty(3 * t, np.int32), np.empty(t, np.int32)
+    me.loop_triangles.foreach_get("loops", loops)
+    me.loop_triangle_polygons.foreach_get("value", faces)
+    return loops, faces
+
+
+def _quad_mesh(kind, rng):
+    """Vertex and face lists of 20,000 faces with fresh vertices each: quads of random
+    corners (two thirds are cut along 1-3), nearly flat quads whose third corner lies on the
+    first two's segment to within rounding (Blender's float32 test and a float64 one
+    disagree on some), or triangles and quads mixed, on integer coordinates (degenerate
+    quads, whose test is exactly 0: not cut along 1-3)."""
+    n = 20_000
+    if kind == "triangles and quads":
+        sizes = rng.integers(3, 5, n)
+    else:
+        sizes = np.full(n, 4)
+    verts = rng.normal(size=(sizes.sum(), 3)).astype(np.float32)
+    if kind == "triangles and quads":       # small integers: many tests come out exactly 0
+        verts = rng.integers(-2, 3, size=verts.shape).astype(np.float32)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    if kind == "nearly flat quads":
+        q = verts.reshape(n, 4, 3)
+        q[:] = q[:, :1] + np.float32(1e-3) * q
+        t = rng.random((n, 1)).astype(np.float32)
+        q[:, 2] = q[:, 0] + (q[:, 1] - q[:, 0]) * t + np.float32(1e-9) * rng.normal(size=(n, 3))
+    return verts, [tuple(range(s, s + k)) for s, k in zip(starts, sizes)]
+
+
+@pytest.mark.parametrize("kind", ["random quads", "nearly flat quads", "triangles and quads"])
+def test_triangles_of_triangles_and_quads_are_blenders(kind):
+    """``corner_triangles`` cuts every quad along the diagonal Blender cuts it along (its
+    float32 test, to the bit) and numbers triangles and corners as ``loop_triangles``."""
+    verts, faces = _quad_mesh(kind, np.random.default_rng(11))
+    me = bpy.data.meshes.new(kind)
+    me.from_pydata(verts.tolist(), [], faces)
+    corner_verts = np.empty(len(me.loops), np.int32)
+    me.attributes[".corner_vert"].data.foreach_get("value", corner_verts)
+    positions = np.empty(3 * len(me.vertices), np.float32)
+    me.vertices.foreach_get("co", positions)
+    starts = np.empty(len(me.polygons), np.int32)
+    me.polygons.foreach_get("loop_start", starts)
+    loops, tri_faces = _blender_triangles(me)
+    got = corner_triangles(starts, len(me.loops), corner_verts, positions.reshape(-1, 3))
+    np.testing.assert_array_equal(got[0], loops)
+    np.testing.assert_array_equal(got[1], tri_faces)
+    quads = starts[np.diff(starts, append=len(me.loops)) == 4]
+    cut_13 = loops.reshape(-1, 3)[quads - 2 * np.searchsorted(starts, quads), 2] == quads + 3
+    assert 0.1 < cut_13.mean() < 0.9
+    if kind == "nearly flat quads":
+        p = positions.reshape(-1, 3).astype(np.float64)[corner_verts[quads[:, None] + np.arange(4)]]
+        a = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        b = np.cross(p[:, 3] - p[:, 0], p[:, 2] - p[:, 0])
+        assert np.sum(((a * b).sum(1) > 0) != cut_13) > 0
+
+
+def test_meshes_with_ngons_get_blenders_triangles(scene, fake_session):
+    """Faces of 5 or more corners need Blender's polygon fill: such a mesh is exported with
+    Blender's triangles (a concave pentagon and quads), a mesh of quads with its own."""
+    ngon = new_mesh_object("Ngon", [(0, 0, 0), (2, 0, 0), (2, 2, 0), (1, 0.5, 0), (0, 2, 0),
+                                    (3, 0, 0), (3, 2, 1)], [(0, 1, 2, 3, 4), (1, 5, 6, 2)])
+    quads = new_mesh_object("Quads", [(0, 0, 0), (2, 0, 0), (2, 2, 0), (1.5, 0.5, 0)], [(0, 1, 2, 3)])
+    quads.location = (0, 0, 3)
+    g = export_scene(fake_session).geometry
+    expected = []
+    for ob in (ngon, quads):
+        me = ob.data
+        corner_verts = np.array([loop.vertex_index for loop in me.loops], np.int32)
+        expected.append(corner_verts[_blender_triangles(me)[0]].reshape(-1, 3))
+    assert g.triangles.shape == (7, 3)
+    np.testing.assert_array_equal(g.triangles[:5], expected[0])
+    np.testing.assert_array_equal(g.triangles[5:] - len(ngon.data.vertices), expected[1])
+    np.testing.assert_array_equal(expected[1], [[0, 1, 3], [1, 2, 3]])   # concave: cut along 1-3
 
 
 def test_uvs_come_from_the_active_render_uv_map(scene, fake_session):

@@ -224,12 +224,15 @@ def light_links(sc, idx, light_set):
 
 
 @device
-def local_light_total(lamps, group, has_group, world, recv):
+def local_light_total(lamps, group, has_group, world, recv, importance):
     """Sum of every light's importance at the receiver (lamps, the emissive triangles as
-    one, and the world's constant importance ``world``, 0 when it is not sampled)."""
+    one, and the world's constant importance ``world``, 0 when it is not sampled); each
+    lamp's is left in ``importance`` (NL,) for :func:`pick_light_local`."""
     total = world
     for li in range(lamps.shape[0]):
-        total += lamp_importance(lamps, li, recv)
+        w = lamp_importance(lamps, li, recv)
+        importance[li] = w
+        total += w
     if has_group:
         total += sphere_importance(group, 0, recv)
     return total
@@ -246,15 +249,14 @@ def lamp_pick_pmf(lamps, li, pmf_mode, recv, total):
 
 
 @device
-def pick_light_local(lamps, group, has_group, world, recv, u):
-    """Pick a light at the receiver (point, normal) in proportion to its importance there.
+def pick_light_local(n_lamps, group, has_group, world, recv, total, importance, u):
+    """Pick a light at the receiver (point, normal) in proportion to its importance there,
+    given what :func:`local_light_total` found there (``total``, ``importance``).
 
     Returns ``(choice, pmf)``: a lamp index, ``n_lamps`` for the emissive
     triangles as a group, or ``n_lamps + 1`` for the world (of importance
     ``world``); ``pmf`` 0 if nothing can light p.
     """
-    n_lamps = lamps.shape[0]
-    total = local_light_total(lamps, group, has_group, world, recv)
     if total <= 0.0:
         return 0, 0.0
     target = u * total
@@ -264,7 +266,7 @@ def pick_light_local(lamps, group, has_group, world, recv, u):
     last = -1
     last_w = 0.0
     for li in range(n_lamps):
-        w = lamp_importance(lamps, li, recv)
+        w = importance[li]
         if w > 0.0:
             acc += w
             last, last_w = li, w

@@ -708,10 +708,18 @@ def _intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
         return math.inf, 0.0, 0.0, 0.0, 0.0
     px, py, pz = cx - ox, cy - oy, cz - oz
     d2 = px * px + py * py + pz * pz
+    disk = lamps[li, L_DISK] > 0.0
+    b_ = px * dx + py * dy + pz * dz
+    disc = r * r - (d2 - b_ * b_)
+    # First the cheap tests (most rays miss most lamps): the ray points away from the lamp or
+    # passes its sphere; a disk lies inside the sphere, and is left to its own test unless
+    # the ray passes by a margin far beyond rounding (so the result is the same).
+    if b_ <= 0.0 or disc < (-1e-12 * d2 if disk else 0.0):
+        return math.inf, 0.0, 0.0, 0.0, 0.0
     if d2 <= r * r or lamp_cone_omc(r, d2) <= DELTA_CONE_OMC:
         return math.inf, 0.0, 0.0, 0.0, 0.0   # inside, or a point from here: rays miss it
-    d = math.sqrt(d2)
-    if lamps[li, L_DISK] > 0.0:
+    if disk:
+        d = math.sqrt(d2)
         # Disk through the centre facing the ray origin.
         nx, ny, nz = px / d, py / d, pz / d
         cos_l = dx * nx + dy * ny + dz * nz
@@ -725,10 +733,6 @@ def _intersect_lamp(lamps, li, ox, oy, oz, dx, dy, dz, tmax, vx, vy, vz):
             return math.inf, 0.0, 0.0, 0.0, 0.0
         pdf = t * t / (math.pi * r * r * cos_l)
     else:
-        b_ = px * dx + py * dy + pz * dz
-        disc = r * r - (d2 - b_ * b_)
-        if disc < 0.0 or b_ <= 0.0:
-            return math.inf, 0.0, 0.0, 0.0, 0.0
         t = b_ - math.sqrt(disc)
         if t <= 0.0 or t >= tmax:
             return math.inf, 0.0, 0.0, 0.0, 0.0

@@ -236,10 +236,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # Light linking: lights found by the ray count if they light the receiver it left
         # (camera rays, also through transparent surfaces, see every light).
         ray_set = st.mis_set[i] if linking and not (flags & PF_CAMERA) else -1
-        mis_total = 0.0
-        if local and mis and not (flags & PF_MIS_SKIP):
-            mis_total = local_light_total(sc.lamps, sc.emit_group, has_group, world_importance,
-                                          mp)
+        mis_total = st.mis_total[i] if local and mis and not (flags & PF_MIS_SKIP) else 0.0
 
         # -- light arriving along the ray ------------------------------------------------------
         if lamps_hit and not exit_walk:
@@ -360,14 +357,18 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
         # the light it finds.
         recv = (sp.hx, sp.hy, sp.hz, 0.0, 0.0, 0.0)
         recv_set = receiver_set(sc, p) if linking else -1     # light linking: its light set
+        total = 0.0       # the lights' summed importance here: this pick's, the next MIS's
         if local:
             rnx, rny, rnz = shader_normal(sc, scratch.regs, sp)
             recv = receiver(sp.hx, sp.hy, sp.hz, rnx, rny, rnz, scratch.cl, ncl)
+            if nee or mis:
+                total = local_light_total(sc.lamps, sc.emit_group, has_group, world_importance,
+                                          recv, scratch.importance)
         if nee:
             lu, lv, u_pick, u_group = sample_4d(sampler, key, bounce_set(vertex, SET_LIGHT), mask)
             if local:
-                idx, pmf = pick_light_local(sc.lamps, sc.emit_group, has_group, world_importance,
-                                            recv, u_pick)
+                idx, pmf = pick_light_local(n_lamps, sc.emit_group, has_group, world_importance,
+                                            recv, total, scratch.importance, u_pick)
                 if idx == n_lamps + 1:
                     idx = world_light
                 elif idx == n_lamps:
@@ -449,6 +450,7 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
             st.mis_pdf[i] = ds.pdf
             for c in range(6):
                 st.mis_p[i, c] = recv[c]
+            st.mis_total[i] = total
             if linking:
                 st.mis_set[i] = recv_set
             st.dp[i] = footprint     # Cycles keeps the camera's dD at every bounce

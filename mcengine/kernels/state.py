@@ -36,6 +36,7 @@ PathState = namedtuple("PathState", [
     "min_pdf",       # (B,) f64      smallest BSDF pdf on the path so far (Filter Glossy)
     "mis_p",         # (B, 6) f64    the receiver that ray left: vertex, normal (0: none; light
                      #               picking there, for MIS: light_sampling.receiver)
+    "mis_total",     # (B,) f64      the lights' summed importance at mis_p (PMF_LOCAL picking)
     "self_prim",     # (B,) int32    triangle the ray starts on (-1: none)
     "mis_set",       # (B,) int32    light set the object at mis_p receives (light linking:
                      #               Cycles' mis_ray_object; 0 for camera rays)
@@ -76,6 +77,7 @@ Scratch = namedtuple("Scratch", [
     "cl_light",            # the same, for evaluating the emission of a light sample
     "regs",                # (R,) f64  the shader evaluator's registers (a copy of SceneData.svm_regs)
     "light",               # (4,) f64  the last light sample: direction, excluded labels
+    "importance",          # (NL,) f64  each lamp's importance at the point being shaded
 ])
 
 SceneData = namedtuple("SceneData", [
@@ -219,7 +221,8 @@ def alloc_path_state(n: int) -> PathState:
         bounce=np.zeros(n, np.int32), diffuse=np.zeros(n, np.int32),
         glossy=np.zeros(n, np.int32), transmission=np.zeros(n, np.int32),
         transparent=np.zeros(n, np.int32), flags=np.zeros(n, np.int32),
-        mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 6)), self_prim=np.zeros(n, np.int32),
+        mis_pdf=np.zeros(n), min_pdf=np.zeros(n), mis_p=np.zeros((n, 6)), mis_total=np.zeros(n),
+        self_prim=np.zeros(n, np.int32),
         mis_set=np.zeros(n, np.int32),
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
@@ -242,6 +245,7 @@ def move_path(st, i, m):
         st.o32[m, c] = st.o32[i, c]
         st.d32[m, c] = st.d32[i, c]
     st.ray_tmax[m] = st.ray_tmax[i]
+    st.mis_total[m] = st.mis_total[i]
     st.transparency[m] = st.transparency[i]
     st.bounce[m] = st.bounce[i]
     st.diffuse[m] = st.diffuse[i]
@@ -270,8 +274,8 @@ def alloc_shadow_queue(n: int) -> ShadowQueue:
 
 
 def alloc_scratch(sc: SceneData) -> Scratch:
-    """A worker's per-hit scratch space for scene ``sc`` (closures, shader registers and the
-    last light sample)."""
+    """A worker's per-hit scratch space for scene ``sc`` (closures, shader registers, the
+    last light sample and the lamps' importances)."""
     return Scratch(cl=np.zeros((MAX_CLOSURES, CL_STRIDE)), cl_light=np.zeros((MAX_CLOSURES, CL_STRIDE)),
-                   regs=sc.svm_regs.copy(), light=np.zeros(4))
+                   regs=sc.svm_regs.copy(), light=np.zeros(4), importance=np.zeros(sc.lamps.shape[0]))
 

@@ -18,11 +18,15 @@ peak resident memory.  Figures:
 
 * first image: wall time of the 1-sample render call (export or sync, BVH, the
   first sample of every pixel);
+* sync: each engine's ``synchronization_time`` from the image's metadata, its total time
+  less its render time (Cycles' blender/session.cpp; MC Engine's the same by definition,
+  ``RenderStats.metadata``; 10 ms resolution): everything before sampling, so for Cycles
+  its scene sync, BVH build and device updates, for MC Engine its export, scene
+  preparation, BVH and kernel loading;
 * MC Engine: its export (Blender -> scene description), scene preparation (packing,
   light tables), BVH (Embree) and kernel loading, from its own timers;
-* Cycles: its synchronisation time (Cycles' own figure, 10 ms resolution) and,
-  estimated, the rest of its start-up (BVH build, device and kernel set-up):
-  first image minus synchronisation minus one sample at the measured rate;
+* the rest of the start-up, estimated: first image minus sync minus one sample at the
+  measured rate (outside both engines' total time: Blender's side of the render call);
 * Mpaths/s: the extra paths of the S-sample render over the 1-sample render per
   extra second (marginal, as in bench_cornell.py);
 * memory: peak resident memory of the process, the part above Blender with the
@@ -202,9 +206,8 @@ def _child(engine: str, blend: str, width: int, height: int, samples: int) -> in
     rate = pixels * (samples - 1) / max(full - first, 1e-9)
     row.update(first_image_s=first, render_1spp_s=first, render_s=full, mpaths_per_s=rate / 1e6,
                rss_scene_mib=rss_scene / 2**20)
-    if engine == "cycles":
-        row.update(sync_s=sync, startup_rest_s=max(first - sync - pixels / rate, 0.0))
-    else:
+    row.update(sync_s=sync, startup_rest_s=max(first - sync - pixels / rate, 0.0))
+    if engine == "mcengine":
         session, desc = timing["obj"], timing["desc"]
         row["buffers_mib"] = session.buffer_bytes / 2**20
         from mcengine.session import _Buffers
@@ -226,8 +229,8 @@ def _rss_now() -> int:
 
 
 def _render(scene, bl_engine, samples, resolution):
-    """(wall seconds of the render call, Cycles' own synchronisation seconds or 0) of one
-    render written to a temporary EXR (not read back)."""
+    """(wall seconds of the render call, the engine's own synchronisation seconds, or 0
+    without them) of one render written to a temporary EXR (not read back)."""
     import bpy
     import OpenEXR
 
@@ -272,7 +275,7 @@ def write_csv(rows, path: Path) -> None:
 def markdown_table(rows) -> str:
     """The rows as a Markdown table; a dash where a figure does not apply to the engine."""
     head = ("| engine | triangles | images | resolution | spp | first image (s) | export (s) | BVH (s) "
-            "| Cycles sync (s) | Cycles other start-up, est. (s) | Mpaths/s | peak RSS (MiB) "
+            "| sync, total - render (s) | other start-up, est. (s) | Mpaths/s | peak RSS (MiB) "
             "| above Blender and the scene (MiB) |")
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
 

@@ -24,7 +24,8 @@ peak resident memory.  Figures:
   its scene sync, BVH build and device updates, for MC Engine its export, scene
   preparation, BVH and kernel loading;
 * MC Engine: its export (Blender -> scene description), scene preparation (packing,
-  light tables), BVH (Embree) and kernel loading, from its own timers;
+  light tables, wall time), BVH (Embree; built beside the packing when nothing moves, so
+  the two overlap) and kernel loading, from its own timers;
 * the rest of the start-up, estimated: first image minus sync minus one sample at the
   measured rate (outside both engines' total time: Blender's side of the render call);
 * Mpaths/s: the extra paths of the S-sample render over the 1-sample render per
@@ -196,7 +197,7 @@ def _child(engine: str, blend: str, width: int, height: int, samples: int) -> in
         stats = timing["obj"].stats
         row.update(export_s=mc_engine.last_render["export_seconds"], bvh_s=stats.time_bvh,
                    kernels_s=stats.time_kernels,
-                   prepare_s=timing["session"] - stats.time_bvh - stats.time_kernels)
+                   prepare_s=timing["session"] - stats.extra["bvh_wait"] - stats.time_kernels)
     # Let the 1-sample render's session go before the next one is built, as Blender does
     # between two renders (held here, it added its film and geometry to the peak).
     timing.clear()

@@ -4,14 +4,15 @@ release the GIL, so independent pieces of a large job run in parallel on threads
 ``map_threads`` is the one thread pool of the host's one-off work (the render's own
 workers are ``session.py``'s): hashing the parts of a large array (``digest``), baking the
 world's map in bands of rows (``background``), and the per-triangle blocks of packing and
-of the export.
+of the export.  ``in_background`` starts one such job while the caller goes on (the BVH
+build beside the scene's packing).
 """
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 
-__all__ = ["map_threads"]
+__all__ = ["in_background", "map_threads"]
 
 
 def map_threads(function, items) -> list:
@@ -24,3 +25,13 @@ def map_threads(function, items) -> list:
         return [function(item) for item in items]
     with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="mcengine-host") as pool:
         return list(pool.map(function, items))
+
+
+def in_background(function) -> Future:
+    """Start function() on a thread of its own; the Future's ``result()`` waits for it and
+    returns its value (or raises its exception)."""
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mcengine-host")
+    try:
+        return pool.submit(function)
+    finally:
+        pool.shutdown(wait=False)

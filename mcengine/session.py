@@ -80,6 +80,7 @@ from .kernels.svm.nodes import (
     R_ROUGHNESS,
 )
 from .packing import pack_passes, pack_scene, scene_images
+from .parallel import in_background
 from .scene import SceneDescription, SceneError
 
 DEFAULT_BATCH = 1 << 17       # paths per chunk: ~50 MB of buffers per worker
@@ -99,7 +100,9 @@ class RenderStats:
                                     # tables, shaders, the world's map (a first run also
                                     # compiles the shader evaluator, which packing runs once
                                     # per material)
-    time_bvh: float = 0.0
+    time_bvh: float = 0.0           # building (or reusing) the BVH; without moving objects
+                                    # on its own thread beside the packing (the two overlap,
+                                    # extra["bvh_wait"]: what was left to wait for after it)
     time_kernels: float = 0.0       # compiling or loading the numba kernels
     time_render: float = 0.0        # tracing and shading, wall clock
     time_embree: float = 0.0        # inside Embree, summed over workers
@@ -318,6 +321,11 @@ class RenderSession:
         self.batch_size = int(batch_size or DEFAULT_BATCH)
         it = scene.integrator
         self.stats = RenderStats(samples_target=it.samples)
+        # Without moving objects the BVH needs nothing of the packing: Embree builds it while
+        # the scene is packed (numpy and Embree release the GIL).
+        visibility = scene.geometry.triangle_visibility()
+        bvh = None if scene.motion_blur and scene.motion_blur.objects else \
+            in_background(lambda: self._build_bvh(scene, None, visibility))
         # The effects plan (``features``): what the scene calls for, as kernel flags.
         t0 = time.perf_counter()
         self.sc, self.cfg, self.fcfg, self.plan = pack_scene(scene, force_effects, images)
@@ -363,10 +371,9 @@ class RenderSession:
         self.active = np.arange(self.film.count.size, dtype=np.int32)
         self.pass_samples = 0          # samples every still-active pixel has
         t0 = time.perf_counter()
-        visibility = scene.geometry.triangle_visibility()
-        self.accel, self.stats.extra["bvh_reused"] = accel_cache.accel_for(
-            scene.geometry.vertices, scene.geometry.triangles, self.sc.motion, visibility)
-        self.stats.time_bvh = time.perf_counter() - t0
+        self.accel, self.stats.extra["bvh_reused"], self.stats.time_bvh = (
+            bvh.result() if bvh is not None else self._build_bvh(scene, self.sc.motion, visibility))
+        self.stats.extra["bvh_wait"] = time.perf_counter() - t0
         if visibility is not None:
             self._warn_ray_visibility()
         t0 = time.perf_counter()
@@ -377,6 +384,16 @@ class RenderSession:
         self._all_workers = []
         self._buffer_bytes = 0
         self._lock = threading.Lock()
+
+    @staticmethod
+    def _build_bvh(scene, motion, visibility):
+        """(BVH, whether it was reused, seconds) of the scene's triangles, with the moving
+        ones of ``motion`` (``kernels.motion.MotionData``; None: nothing moves) and each
+        triangle's ray ``visibility`` (``Geometry.triangle_visibility``)."""
+        t0 = time.perf_counter()
+        accel, reused = accel_cache.accel_for(scene.geometry.vertices, scene.geometry.triangles,
+                                              motion, visibility)
+        return accel, reused, time.perf_counter() - t0
 
     def _warn_ray_visibility(self) -> None:
         """Name where objects' Ray Visibility (some object's) is not honoured (every ray

@@ -3,7 +3,7 @@ import threading
 
 import pytest
 
-from mcengine.parallel import map_threads
+from mcengine.parallel import in_background, map_threads
 
 
 def test_results_come_in_the_order_of_the_items_from_threads():
@@ -27,3 +27,23 @@ def test_an_exception_in_any_call_is_raised_to_the_caller():
 
     with pytest.raises(ValueError, match="seven"):
         map_threads(fail_on_seven, range(10))
+
+
+def test_a_background_job_runs_beside_the_caller_and_hands_back_its_result_or_error():
+    started, release = threading.Event(), threading.Event()
+
+    def job():
+        started.set()
+        assert release.wait(5.0)          # runs while the caller goes on
+        return threading.current_thread().name
+
+    future = in_background(job)
+    assert started.wait(5.0) and not future.done()
+    release.set()
+    assert future.result(5.0) != threading.current_thread().name
+
+    def fail():
+        raise ValueError("bvh")
+
+    with pytest.raises(ValueError, match="bvh"):
+        in_background(fail).result(5.0)

@@ -5,9 +5,9 @@ triangles or the same world are recognised by their bytes, whatever object holds
 SHA-256, because these CPUs hash it in hardware (SHA extensions): a 4096 x 2048 float
 RGBA image (128 MB) took 86 ms where BLAKE2b took 174 ms.  Arrays of more than
 ``SPLIT_BYTES`` are hashed in ``PARTS`` parts on threads (``parallel.map_threads``:
-hashlib releases the GIL), the parts' digests then hashed in order: a two-level hash tree, as strong as
-SHA-256 itself; the parts depend on the array's size only, so the same bytes give the
-same digest on any machine.
+hashlib releases the GIL), the parts' digests then hashed in order: a two-level hash
+tree, as strong as SHA-256 itself; the parts depend on the array's size only, so the
+same bytes give the same digest on any machine.
 """
 from __future__ import annotations
 

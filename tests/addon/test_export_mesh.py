@@ -106,8 +106,7 @@ def test_shading_normals_equal_blender_corner_normals(scene, fake_session, shadi
         for edge in me.edges:
             edge.use_edge_sharp = set(edge.vertices).issubset(me.polygons[0].vertices)
     assert me.normals_domain == domain
-    loops = np.empty(len(me.loop_triangles) * 3, np.int32)
-    me.loop_triangles.foreach_get("loops", loops)
+    loops = _blender_triangles(me)[0]
     corner = np.empty(len(me.loops) * 3, np.float32)
     me.corner_normals.foreach_get("vector", corner)
     g = export_scene(fake_session).geometry
@@ -598,8 +597,7 @@ def test_tangents_of_a_mesh_with_custom_normals_are_blenders_own(scene, fake_ses
     tangent = export_scene(fake_session).geometry.attributes["tangent:"].reshape(-1, 4)
     me.calc_tangents()
     me.calc_loop_triangles()
-    loops = np.empty(3 * len(me.loop_triangles), np.int32)
-    me.loop_triangles.foreach_get("loops", loops)
+    loops = _blender_triangles(me)[0]
     expected = np.empty(3 * len(me.loops), np.float32)
     me.loops.foreach_get("tangent", expected)
     np.testing.assert_allclose(tangent[:, :3], expected.reshape(-1, 3)[loops], atol=1e-6)

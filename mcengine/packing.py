@@ -142,13 +142,7 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
     g = scene.geometry
     verts = g.vertices.astype(np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
-    if len(tris):
-        tri_area, tri_normal = areas_and_normals(verts, tris)
-        lo, hi = verts.min(axis=0), verts.max(axis=0)
-    else:
-        tri_area = np.zeros(0)
-        tri_normal = np.zeros((0, 3))
-        lo = hi = np.zeros(3)
+    lo, hi = (verts.min(axis=0), verts.max(axis=0)) if len(tris) else (np.zeros(3), np.zeros(3))
     lamp_pos = [np.asarray(li.matrix_world, float)[:3, 3] for li in scene.lights if li.type != "SUN"]
     if lamp_pos:
         lo = np.minimum(lo, np.min(lamp_pos, axis=0))
@@ -173,8 +167,7 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=np.zeros((0, LIGHT_STRIDE)), ies=np.zeros(1), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
         emit_cdf=np.zeros(1), emit_group=np.zeros((1, S_STRIDE)), emit_tree=no_tree(),
-        tri_light=np.full(len(tris), -1, np.int32),
-        tri_area=tri_area, tri_normal=tri_normal,
+        tri_light=none_i,
         world=shaders.emission[world].copy(), camera=camera,
         filter_table=filter_table(film.filter_type, film.filter_width),
         tex=TextureData(attr=attr, normals=normals,
@@ -203,7 +196,11 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
 
     # Lights: lamps, and the triangles of emissive materials.
     if len(tris):
-        emissive = ((shaders.flags[mat_index] & MF_EMISSIVE) != 0) & (tri_area > 0.0)
+        # The kernels compute the triangles' areas where they need them: here only the
+        # emissive materials' triangles need theirs.
+        emissive = (shaders.flags[mat_index] & MF_EMISSIVE) != 0
+        candidates = np.flatnonzero(emissive)
+        emissive[candidates] = areas_and_normals(verts, tris[candidates])[0] > 0.0
         # An emissive object that no diffuse, glossy, transmission or volume scatter ray sees
         # is no light (Cycles' Object::usable_as_light); the lobes the others do not see are
         # excluded from its light samples (light_sampling.emitter_exclude).
@@ -219,9 +216,11 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         estimates = np.zeros((int(varies.sum()), 3))
         emission_estimates(sc, alloc_scratch(sc), emit_tri[varies], estimates)
         radiance[varies] = np.maximum(estimates, 0.0)
-    emit_power = radiance.mean(axis=1) * math.pi * tri_area[emit_tri]
-    tri_light = np.full(len(tris), -1, np.int32)
-    tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
+    emit_power = radiance.mean(axis=1) * math.pi * areas_and_normals(verts, tris[emit_tri])[0]
+    tri_light = none_i       # no emissive triangle: no table (4 bytes per triangle)
+    if len(emit_tri):
+        tri_light = np.full(len(tris), -1, np.int32)
+        tri_light[emit_tri] = np.arange(len(emit_tri), dtype=np.int32)
 
     lamps, lamp_power = pack_lights(scene.lights, scene_radius)
     ies = pack_profiles(scene.lights, lamps)

@@ -191,9 +191,9 @@ def shade_classic(start, end, prim, st, nx, n_next, sq, acc, sc, cfg, fcfg, scra
                                                   dx, dy, dz, flags, mis_pdf, PMF_EVERY,
                                                   mp, 0.0, direct, -1)
             continue
-        if sc.tri_area[p] <= 0.0:
-            continue
         sp = surface_point(sc, p, b1, b2, dx, dy, dz, st.time[i])
+        if sp.area <= 0.0:
+            continue
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):

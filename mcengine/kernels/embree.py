@@ -182,6 +182,9 @@ class _PacketScene:
             self._first = np.zeros(1, np.int64)
             self._ids = np.zeros(0, np.int32)
         self._first = self._first.astype(np.int32)
+        triangles = np.ascontiguousarray(triangles)
+        if triangles.dtype == np.int32:     # the same bits (indices are not negative): no copy
+            triangles = triangles.view(np.uint32)
         self._triangles = np.ascontiguousarray(triangles, np.uint32)
         self._scene = lib.rtcNewScene(library.device)
         lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST)

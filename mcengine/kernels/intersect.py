@@ -282,10 +282,26 @@ def prim_normals(sc, p, time):
 
 
 @device
+def triangle_frame(verts, tris, p):
+    """Unit geometric normal (from the winding) and area of triangle p of ``verts`` and
+    ``tris``, as ``packing.areas_and_normals`` computes them, to the bit (a zero-length
+    normal comes back as it is).  Computed where it is needed rather than stored: a table
+    would cost 32 bytes per triangle, and fresh memory costs start-up time."""
+    a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
+    ax, ay, az = verts[a, 0], verts[a, 1], verts[a, 2]
+    e1x, e1y, e1z = verts[b, 0] - ax, verts[b, 1] - ay, verts[b, 2] - az
+    e2x, e2y, e2z = verts[c, 0] - ax, verts[c, 1] - ay, verts[c, 2] - az
+    nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+    length = math.sqrt(nx * nx + ny * ny + nz * nz)
+    d = length if length > 0.0 else 1.0
+    return nx / d, ny / d, nz / d, 0.5 * length
+
+
+@device
 def prim_frame(sc, p, time):
     """Unit geometric normal (from the winding) and area of triangle p at ``time``."""
     if not is_moving(sc, p):
-        return sc.tri_normal[p, 0], sc.tri_normal[p, 1], sc.tri_normal[p, 2], sc.tri_area[p]
+        return triangle_frame(sc.verts, sc.tris, p)
     ax, ay, az, bx, by, bz, cx, cy, cz = moving_triangle(sc.motion, sc.verts, sc.tris, p, time)
     e1x, e1y, e1z = bx - ax, by - ay, bz - az
     e2x, e2y, e2z = cx - ax, cy - ay, cz - az

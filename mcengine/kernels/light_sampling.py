@@ -384,7 +384,7 @@ def emitter_pick_pmf(sc, fcfg, pmf_mode, mp, mis_total, j):
 def emission_weight(sc, fcfg, p, area, t_hit, cos_o_geo, flags, mis_pdf, pmf_mode, mp,
                     mis_total):
     """MIS weight of emission found by a BSDF ray on emissive triangle p (of that ``area``)."""
-    if flags & PF_MIS_SKIP:
+    if flags & PF_MIS_SKIP or sc.tri_light.shape[0] == 0:
         return 1.0
     j = sc.tri_light[p]
     if j < 0:

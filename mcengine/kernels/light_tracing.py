@@ -57,7 +57,7 @@ from .closures.layout import (
 )
 from .emission import emitter_distribution, sample_emission, spot_cones
 from .importance import camera_sees, in_film, splat
-from .intersect import SHADOW_SHORTEN, offset_origin
+from .intersect import SHADOW_SHORTEN, offset_origin, triangle_frame
 from .lights import (
     L_FLAGS,
     L_LIGHT_SETS,
@@ -273,7 +273,7 @@ def extend_light_paths(n, prim, st, sq, sc, cfg, scratch, cam_scratch, n_pixels,
                     ox + s * dx, oy + s * dy, oz + s * dz, dx, dy, dz, math.inf)
             continue
         st.alive[i] = 0
-        if p < 0 or sc.tri_area[p] <= 0.0:
+        if p < 0 or triangle_frame(sc.verts, sc.tris, p)[3] <= 0.0:
             continue
         t_hit, b1, b2 = hit_distance(sc, p, ox, oy, oz, dx, dy, dz, math.inf, _TIME)
         sp, res = _shade_for(sc, scene_ref, cfg, scratch, p, b1, b2, dx, dy, dz, t_hit, 0)

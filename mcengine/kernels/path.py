@@ -266,9 +266,9 @@ def shade(n, prim, st, sq, sc, cfg, fcfg, scratch, stats, pd, pb, fp):
                 _pass_light(pd, fp, st, pb, i, r0, g0, b0, LK_SURFACE)
             background_passes(pd, fp, st.pixel[i], flags)
             continue
-        if sc.tri_area[p] <= 0.0:
-            continue   # degenerate triangle: Embree should not report it; drop the path
         sp = surface_point(sc, p, b1, b2, dx, dy, dz, st.time[i])
+        if sp.area <= 0.0:
+            continue   # degenerate triangle: Embree should not report it; drop the path
         m = sc.mat_index[p]
         terminate = (flags & PF_TERMINATE) != 0
         if terminate and not (sc.mat_flags[m] & MF_EMISSIVE):
@@ -478,7 +478,7 @@ def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex, sampler, mask):
     wkey = walk_key(st.key[i], vertex)
     if cl[k, CL_SSS_METHOD] == SSS_BURLEY:
         left, q, ex, ey, ez, gx, gy, gz, wr, wg, wb = disk_probe(
-            sc.local, sc.verts, sc.tris, sc.normals, sc.tri_normal, obj, sampler, wkey, mask,
+            sc.local, sc.verts, sc.tris, sc.normals, obj, sampler, wkey, mask,
             sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz, sp.backfacing, cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
             cl[k, CL_RADIUS + 2])
         if not left:

@@ -46,7 +46,7 @@ from .closures import (
     free_side,
 )
 from .closures.layout import CL_SW, CL_TERMINATOR, CL_TYPE, CL_W, CT_BSSRDF, CT_DIFFUSE
-from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin
+from .intersect import SHADOW_SHORTEN, T_INFINITE, offset_origin, triangle_frame
 from .light_sampling import (
     PMF_GLOBAL,
     PMF_LOCAL,
@@ -411,10 +411,10 @@ def emission_estimates(sc, scratch, tris, out):
     for j in range(tris.shape[0]):
         t = tris[j]
         r = g = b = 0.0
+        nx, ny, nz, _ = triangle_frame(sc.verts, sc.tris, t)
         for k in range(4):
             b1, b2 = points[k]
-            er, eg, eb = emission_at(sc, scratch, t, b1, b2, -sc.tri_normal[t, 0],
-                                     -sc.tri_normal[t, 1], -sc.tri_normal[t, 2], 1.0,
+            er, eg, eb = emission_at(sc, scratch, t, b1, b2, -nx, -ny, -nz, 1.0,
                                      (0, 0, 0, 0, 0), 0.5)
             r += er
             g += eg

@@ -101,9 +101,7 @@ SceneData = namedtuple("SceneData", [
     "emit_group",    # (1, 5) f64   emissive triangles as one light: centre, radius^2, scale
                      #              (a row of light_tree.sphere_importance)
     "emit_tree",     # kernels.light_tree.EmitterTree: picks one of them at a point
-    "tri_light",     # (T,) int32   index into emit_tri, or -1
-    "tri_area",      # (T,) f64
-    "tri_normal",    # (T, 3) f64  unit geometric normal (from the winding)
+    "tri_light",     # (T,) int32   index into emit_tri, or -1 (empty without emit_tri)
     "world",         # (3,) f64     background radiance (when constant: CFG_WORLD_SHADER 0)
     "camera",        # (CAMERA_PARAMS,) f64
     "filter_table",  # (FILTER_TABLE_SIZE,) f64

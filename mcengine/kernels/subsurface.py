@@ -40,6 +40,7 @@ from ..jit import device
 from . import embree
 from .closures.bssrdf import disk_sample, disk_weight
 from .embree import intersect_one
+from .intersect import triangle_frame
 from .motion import BVH_LEAF, build_bvh, hit_triangle, ray_box
 from .sampling import make_orthonormals, orthonormal_basis, rand, sample_2d, sample_4d
 
@@ -411,13 +412,13 @@ def random_walk(lb, verts, tris, obj, sampler, wkey, mask, px, py, pz, dx, dy, d
 
 # -- Christensen-Burley: a disk probe ------------------------------------------------------------
 @device
-def _hit_weight(normals, tri_normal, p, hx, hy, hz, px, py, pz, flip, axes, picks, scale,
+def _hit_weight(normals, verts, tris, p, hx, hy, hz, px, py, pz, flip, axes, picks, scale,
                 radius, disk_r):
     """Weight (r, g, b) of the probe's hit h on triangle p: the profile at its distance
     from p0 = (px, py, pz) over the disk's pdf, times the MIS weight of the disk's axis
     (power heuristic over the three ``axes`` (n, t, b) picked with probabilities ``picks``)
     and ``scale``."""
-    gx, gy, gz = hit_normal(normals, tri_normal, p, flip)
+    gx, gy, gz = hit_normal(normals, verts, tris, p, flip)
     pdf_n = picks[0] * abs(axes[0] * gx + axes[1] * gy + axes[2] * gz)
     pdf_t = picks[1] * abs(axes[3] * gx + axes[4] * gy + axes[5] * gz)
     pdf_b = picks[2] * abs(axes[6] * gx + axes[7] * gy + axes[8] * gz)
@@ -428,10 +429,11 @@ def _hit_weight(normals, tri_normal, p, hx, hy, hz, px, py, pz, flip, axes, pick
 
 
 @device
-def hit_normal(normals, tri_normal, p, flip):
+def hit_normal(normals, verts, tris, p, flip):
     """Triangle p's geometric normal, on the side its corner normals say, flipped when the
     probe started on a back face."""
-    gx, gy, gz = facing_corners(normals, p, tri_normal[p, 0], tri_normal[p, 1], tri_normal[p, 2])
+    gx, gy, gz, _ = triangle_frame(verts, tris, p)
+    gx, gy, gz = facing_corners(normals, p, gx, gy, gz)
     if flip:
         gx, gy, gz = -gx, -gy, -gz
     return gx, gy, gz
@@ -499,7 +501,7 @@ def probe(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, key):
 
 
 @device
-def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, px, py, pz,
+def disk_probe(lb, verts, tris, normals, obj, sampler, wkey, mask, px, py, pz,
                ngx, ngy, ngz, backfacing, rr, rg, rb):
     """Christensen-Burley's exit from point p (geometric normal ng on the viewer's side) of
     object ``obj``, radius r per channel.
@@ -527,18 +529,18 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, p
     picks = (pick_n, pick_t, pick_b)
     radius = (rr, rg, rb)
     wr1 = wg1 = wb1 = wr2 = wg2 = wb2 = wr3 = wg3 = wb3 = 0.0
-    wr0, wg0, wb0 = _hit_weight(normals, tri_normal, p0, ox + t0 * dx, oy + t0 * dy, oz + t0 * dz,
+    wr0, wg0, wb0 = _hit_weight(normals, verts, tris, p0, ox + t0 * dx, oy + t0 * dy, oz + t0 * dz,
                                 px, py, pz, backfacing, axes, picks, scale, radius, disk_r)
     if kept > 1:
-        wr1, wg1, wb1 = _hit_weight(normals, tri_normal, p1, ox + t1 * dx, oy + t1 * dy,
+        wr1, wg1, wb1 = _hit_weight(normals, verts, tris, p1, ox + t1 * dx, oy + t1 * dy,
                                     oz + t1 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     if kept > 2:
-        wr2, wg2, wb2 = _hit_weight(normals, tri_normal, p2, ox + t2 * dx, oy + t2 * dy,
+        wr2, wg2, wb2 = _hit_weight(normals, verts, tris, p2, ox + t2 * dx, oy + t2 * dy,
                                     oz + t2 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     if kept > 3:
-        wr3, wg3, wb3 = _hit_weight(normals, tri_normal, p3, ox + t3 * dx, oy + t3 * dy,
+        wr3, wg3, wb3 = _hit_weight(normals, verts, tris, p3, ox + t3 * dx, oy + t3 * dy,
                                     oz + t3 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     s0 = abs(wr0 + wg0 + wb0) / 3.0
@@ -558,5 +560,5 @@ def disk_probe(lb, verts, tris, normals, tri_normal, obj, sampler, wkey, mask, p
     else:
         p, t, sw, wr, wg, wb = p3, t3, s3, wr3, wg3, wb3
     k = total / sw
-    gx, gy, gz = hit_normal(normals, tri_normal, p, backfacing)
+    gx, gy, gz = hit_normal(normals, verts, tris, p, backfacing)
     return True, p, ox + t * dx, oy + t * dy, oz + t * dz, gx, gy, gz, wr * k, wg * k, wb * k

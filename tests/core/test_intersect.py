@@ -1,9 +1,11 @@
 """Embree closest hits against a brute-force float64 triangle test."""
 import numpy as np
 import pytest
+from numba import njit
 
 from mcengine.kernels import embree
-from mcengine.kernels.intersect import Accel, intersect_triangle
+from mcengine.kernels.intersect import Accel, intersect_triangle, triangle_frame
+from mcengine.packing import areas_and_normals
 
 # Both ways of calling Embree: packets through the library's C API (the default) and
 # embreex's single rays (the fallback where the library is not found).
@@ -126,3 +128,39 @@ def test_packets_are_the_default_and_agree_with_embreex_ray_for_ray():
     blocked = fast.occluded(o, d, t)
     assert np.array_equal(blocked, single.occluded(o, d, t))
     assert np.array_equal(blocked, prim >= 0)
+
+
+@njit(cache=False)
+def _frames(verts, tris):
+    out = np.empty((tris.shape[0], 4))
+    for p in range(tris.shape[0]):
+        out[p, 0], out[p, 1], out[p, 2], out[p, 3] = triangle_frame(verts, tris, p)
+    return out
+
+
+def test_triangle_frames_are_the_packed_ones_to_the_bit():
+    """The kernels compute a triangle's normal and area where they need them
+    (``triangle_frame``); the packing computes the emissive triangles' (and displacement
+    all of them) with ``areas_and_normals``: both give the same bits, on ordinary, sliver,
+    tiny, huge, collinear and repeated-vertex triangles."""
+    rng = np.random.default_rng(11)
+    groups = [rng.uniform(-10, 10, (3000, 3)), rng.uniform(-1e-20, 1e-20, (300, 3)),
+              rng.uniform(-1e6, 1e6, (300, 3))]
+    # Each group's own triangles, corners distinct: none of them is degenerate.
+    tris, first = [], 0
+    for g in groups:
+        tris.append(first + np.argsort(rng.random((len(g), len(g))), axis=1)[:, :3])
+        first += len(g)
+    verts = np.concatenate(groups + [[[0, 0, 0], [1, 1, 1], [2, 2, 2]]])
+    verts = verts.astype(np.float32).astype(np.float64)     # as the packed scene's
+    # A cross product whose square underflows: a zero length, a non-zero normal.
+    verts = np.concatenate([verts, [[1e-160, 0, 0], [0, 1e-160, 0]]])
+    n = len(verts)
+    degenerate = np.array([[0, 0, 5]] * 5 + [[n - 5, n - 4, n - 3]] * 5 + [[n - 5, n - 2, n - 1]] * 5)
+    tris = np.concatenate([degenerate] + tris).astype(np.int32)
+    area, normal = areas_and_normals(verts, tris)
+    frames = _frames(verts, tris)
+    assert np.array_equal(frames[:, :3].view(np.uint64), normal.view(np.uint64))
+    assert np.array_equal(frames[:, 3].view(np.uint64), area.view(np.uint64))
+    assert (area[:15] == 0.0).all() and (area[15:] > 0.0).all()
+    assert (normal[10:15, 2] > 0.0).all()

@@ -191,3 +191,5 @@ def test_film_read_out_is_exact_and_flips_without_copies():
     flipped = film.image(2.0, bottom_up=True)
     assert flipped.flags.c_contiguous
     np.testing.assert_array_equal(flipped, img[::-1])
+    plain = (film.sum / np.maximum(film.count, 1)[:, None]).astype(np.float32)
+    np.testing.assert_array_equal(film.image().reshape(-1, 4), plain)

@@ -640,6 +640,9 @@ class Integrator:
     use_adaptive_sampling: bool = False
     adaptive_threshold: float = 0.01   # relative noise at which a pixel stops (0: automatic)
     adaptive_min_samples: int = 0      # samples before a pixel may stop (0: automatic)
+    # Performance > Acceleration Structure: how Embree builds the BVH (kernels.embree.build).
+    use_spatial_splits: bool = False
+    use_compact_bvh: bool = False
 
 
 @dataclass

@@ -391,8 +391,10 @@ class RenderSession:
         ones of ``motion`` (``kernels.motion.MotionData``; None: nothing moves) and each
         triangle's ray ``visibility`` (``Geometry.triangle_visibility``)."""
         t0 = time.perf_counter()
+        it = scene.integrator
         accel, reused = accel_cache.accel_for(scene.geometry.vertices, scene.geometry.triangles,
-                                              motion, visibility)
+                                              motion, visibility, it.use_spatial_splits,
+                                              it.use_compact_bvh)
         return accel, reused, time.perf_counter() - t0
 
     def _warn_ray_visibility(self) -> None:

@@ -121,6 +121,8 @@ def export_integrator(ctx, scene, view_layer) -> Integrator:
         use_adaptive_sampling=bool(cycles.use_adaptive_sampling),
         adaptive_threshold=float(cycles.adaptive_threshold),
         adaptive_min_samples=int(cycles.adaptive_min_samples),
+        use_spatial_splits=bool(cycles.debug_use_spatial_splits),
+        use_compact_bvh=bool(cycles.debug_use_compact_bvh),
         sampler=export_sampler(ctx, scene, cycles),
         **mcengine_settings(scene),
     )

@@ -46,7 +46,10 @@ _BUFFER_TYPE_INDEX = 0
 _BUFFER_TYPE_VERTEX = 1
 _FORMAT_UINT3 = 0x5003
 _FORMAT_FLOAT3 = 0x9003
+_SCENE_FLAG_COMPACT = 1 << 1
 _SCENE_FLAG_ROBUST = 1 << 2
+_BUILD_QUALITY_MEDIUM = 1     # Embree's default; Cycles' without spatial splits
+_BUILD_QUALITY_HIGH = 2       # with spatial splits
 
 # Rows of a packet, each PACKET values wide (the struct-of-arrays RTCRayHit8): the ray, then
 # the hit.  Embree writes instPrimID after instID when built with instance arrays, so the
@@ -67,6 +70,8 @@ class _Library:
             "rtcGetDeviceError": (ctypes.c_int, [vp]),
             "rtcNewScene": (vp, [vp]),
             "rtcSetSceneFlags": (None, [vp, ctypes.c_int]),
+            "rtcSetSceneBuildQuality": (None, [vp, ctypes.c_int]),
+            "rtcSetGeometryBuildQuality": (None, [vp, ctypes.c_int]),
             "rtcNewGeometry": (vp, [vp, ctypes.c_int]),
             "rtcSetSharedGeometryBuffer": (None, [vp, ctypes.c_int, ctypes.c_uint, ctypes.c_int, vp,
                                                   ctypes.c_size_t, ctypes.c_size_t, ctypes.c_size_t]),
@@ -123,19 +128,24 @@ def _load() -> _Library | None:
         return _library
 
 
-def build(vertices, triangles, packets: bool = True, masks=None):
+def build(vertices, triangles, packets: bool = True, masks=None, spatial_splits: bool = False,
+          compact: bool = False):
     """A committed Embree scene of these triangles, with ``closest`` and ``occluded``.
 
     vertices : (V, 3) float32-convertible; triangles : (T, 3) int, T > 0.
     ``masks`` : (T,) uint32, optional: each triangle's visibility mask; a ray (whose own
     mask the queries take) passes through the triangles whose mask shares no bit with its.
     ``packets=False`` (or no library found) uses embreex's single-ray API, which has no
-    masks: every triangle is then visible to every ray (``masked`` is False).
+    masks: every triangle is then visible to every ray (``masked`` is False), and its own
+    BVH settings.  The library's BVH is built as Cycles builds it (bvh/embree.cpp): robust,
+    medium build quality, high with ``spatial_splits`` (Cycles' Use Spatial Splits), and
+    Embree's compact layout with ``compact`` (Use Compact BVH: at 4 million triangles 136 MB
+    instead of 246 MB, traversed more slowly).
     """
     library = _load() if packets else None
     if library is None:
         return _EmbreexScene(vertices, triangles)
-    return _PacketScene(library, vertices, triangles, masks)
+    return _PacketScene(library, vertices, triangles, masks, spatial_splits, compact)
 
 
 def build_local(vertices, triangles):
@@ -163,7 +173,8 @@ class _PacketScene:
     (Embree's masks are per geometry); a hit's primitive id is then mapped back from its
     geometry's to the caller's numbering."""
 
-    def __init__(self, library: _Library, vertices, triangles, masks=None):
+    def __init__(self, library: _Library, vertices, triangles, masks=None,
+                 spatial_splits: bool = False, compact: bool = False):
         lib = library.lib
         self._library = library
         vertices = np.asarray(vertices, np.float32)
@@ -187,10 +198,13 @@ class _PacketScene:
             triangles = triangles.view(np.uint32)
         self._triangles = np.ascontiguousarray(triangles, np.uint32)
         self._scene = lib.rtcNewScene(library.device)
-        lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST)
+        lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST | (_SCENE_FLAG_COMPACT if compact else 0))
+        quality = _BUILD_QUALITY_HIGH if spatial_splits else _BUILD_QUALITY_MEDIUM
+        lib.rtcSetSceneBuildQuality(self._scene, quality)
         ends = [*self._first[1:], len(self._triangles)]
         for mask, first, end in zip(groups, self._first, ends):
             geometry = lib.rtcNewGeometry(library.device, _GEOMETRY_TYPE_TRIANGLE)
+            lib.rtcSetGeometryBuildQuality(geometry, quality)
             lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_VERTEX, 0, _FORMAT_FLOAT3,
                                            self._vertices.ctypes.data, 0, 12, len(vertices))
             lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_TYPE_INDEX, 0, _FORMAT_UINT3,

@@ -78,12 +78,15 @@ class Accel:
         Trace in Embree's packets (``kernels.embree``); False: embreex's single rays.
     visibility : (T,) integer, optional
         Each triangle's ray visibility (``VIS_*`` bits; absent: visible to every ray).
+    spatial_splits, compact : bool
+        Cycles' Use Spatial Splits and Use Compact BVH (``embree.build``).
 
     ``masked`` is True when some triangle is hidden from some rays: the callers then pass
     their rays' masks to the queries (``mask``: one for every ray, or one per ray).
     """
 
-    def __init__(self, vertices, triangles, motion=None, packets=True, visibility=None):
+    def __init__(self, vertices, triangles, motion=None, packets=True, visibility=None,
+                 spatial_splits=False, compact=False):
         self.num_triangles = int(len(triangles))
         self._scene = None
         self._motion = motion if motion is not None and len(motion.tri_slot) else None
@@ -104,7 +107,8 @@ class Accel:
                 self._slot_masks[slots[slots >= 0]] = visibility[slots >= 0]
                 visibility = visibility[self._static_ids]
         if len(triangles):
-            self._scene = embree.build(vertices, triangles, packets, visibility)
+            self._scene = embree.build(vertices, triangles, packets, visibility, spatial_splits,
+                                       compact)
         self.masked = visibility is not None and (self._scene is None or self._scene.masked)
 
     def closest(self, origins, directions, tfar, time=None, mask=None):

@@ -20,6 +20,15 @@ def test_integrator_reads_cycles_settings(scene, fake_session):
     assert desc.warnings == []
 
 
+def test_acceleration_structure_settings_are_read(scene, fake_session):
+    """Performance > Acceleration Structure, which Cycles' panel shows for MC Engine too."""
+    i = export_scene(fake_session).integrator
+    assert (i.use_spatial_splits, i.use_compact_bvh) == (False, False)     # Cycles' defaults
+    scene.cycles.debug_use_spatial_splits = scene.cycles.debug_use_compact_bvh = True
+    i = export_scene(fake_session).integrator
+    assert (i.use_spatial_splits, i.use_compact_bvh) == (True, True)
+
+
 def test_adaptive_sampling_and_integrator_choice(scene, fake_session):
     c = scene.cycles
     c.use_adaptive_sampling, c.adaptive_threshold, c.adaptive_min_samples = True, 0.03, 12

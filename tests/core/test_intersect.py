@@ -164,3 +164,57 @@ def test_triangle_frames_are_the_packed_ones_to_the_bit():
     assert np.array_equal(frames[:, 3].view(np.uint64), area.view(np.uint64))
     assert (area[:15] == 0.0).all() and (area[15:] > 0.0).all()
     assert (normal[10:15, 2] > 0.0).all()
+
+
+@pytest.mark.parametrize("spatial_splits, compact", [(True, False), (False, True), (True, True)],
+                         ids=["spatial-splits", "compact", "both"])
+def test_cycles_bvh_settings_reach_embree_and_find_the_same_hits(spatial_splits, compact,
+                                                                 monkeypatch):
+    """Use Spatial Splits and Use Compact BVH: Embree is asked for its high build quality and
+    its compact layout (which holds the same triangles in less memory, counted by Embree's
+    memory monitor), and every ray finds what the default BVH finds."""
+    import ctypes
+    library = embree._load()
+    qualities = []
+    set_quality = library.lib.rtcSetSceneBuildQuality
+    monkeypatch.setattr(library.lib, "rtcSetSceneBuildQuality",
+                        lambda scene, quality: (qualities.append(quality), set_quality(scene, quality)))
+    monitor = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_ssize_t, ctypes.c_bool)
+    allocated = [0]
+
+    def count(_user, nbytes, _post):
+        allocated[0] += max(nbytes, 0)
+        return True
+
+    callback = monitor(count)
+    library.lib.rtcSetDeviceMemoryMonitorFunction.argtypes = [ctypes.c_void_p, monitor, ctypes.c_void_p]
+    rng = np.random.default_rng(5)
+    centers = rng.uniform(-1, 1, (20000, 1, 3))
+    tris = (centers + 0.05 * rng.standard_normal((20000, 3, 3))).reshape(-1, 3).astype(np.float32)
+    index = np.arange(len(tris), dtype=np.int32).reshape(-1, 3)
+    library.lib.rtcSetDeviceMemoryMonitorFunction(library.device, callback, None)
+    try:
+        default = Accel(tris, index)
+        default_bytes, allocated[0] = allocated[0], 0
+        chosen = Accel(tris, index, spatial_splits=spatial_splits, compact=compact)
+        chosen_bytes = allocated[0]
+    finally:
+        library.lib.rtcSetDeviceMemoryMonitorFunction(library.device, monitor(), None)
+    assert qualities == [1, 2 if spatial_splits else 1]      # medium, then high with splits
+    if compact:
+        assert chosen_bytes < 0.8 * default_bytes
+    o = rng.uniform(-2, 2, (4000, 3)).astype(np.float32)
+    d = rng.normal(size=(4000, 3))
+    d = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
+    tfar = np.full(4000, 1e30, np.float32)
+    prim, prim2 = default.closest(o, d, tfar), chosen.closest(o, d, tfar)
+    assert (prim >= 0).sum() > 500
+    # Embree's test of a ray against a triangle does not depend on the BVH: the same hits
+    # but where two triangles meet the ray at the same distance.
+    for i in np.flatnonzero(prim2 != prim):
+        assert prim[i] >= 0 and prim2[i] >= 0
+        t1 = intersect_triangle(*o[i], *d[i], *tris[3 * prim[i]:3 * prim[i] + 3].ravel())[0]
+        t2 = intersect_triangle(*o[i], *d[i], *tris[3 * prim2[i]:3 * prim2[i] + 3].ravel())[0]
+        assert abs(t1 - t2) < 1e-5
+    assert (prim2 == prim).mean() > 0.999
+    np.testing.assert_array_equal(chosen.occluded(o, d, tfar), default.occluded(o, d, tfar))

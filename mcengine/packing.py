@@ -200,7 +200,8 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         # emissive materials' triangles need theirs.
         emissive = (shaders.flags[mat_index] & MF_EMISSIVE) != 0
         candidates = np.flatnonzero(emissive)
-        emissive[candidates] = areas_and_normals(verts, tris[candidates])[0] > 0.0
+        candidate_area = areas_and_normals(verts, tris[candidates])[0]
+        emissive[candidates] = candidate_area > 0.0
         # An emissive object that no diffuse, glossy, transmission or volume scatter ray sees
         # is no light (Cycles' Object::usable_as_light); the lobes the others do not see are
         # excluded from its light samples (light_sampling.emitter_exclude).
@@ -209,6 +210,7 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
             emissive &= (visibility & (VIS_DIFFUSE | VIS_GLOSSY | VIS_TRANSMISSION | VIS_SCATTER)) != 0
     else:
         emissive = np.zeros(0, bool)
+        candidates, candidate_area = np.zeros(0, np.int64), np.zeros(0)
     emit_tri = np.flatnonzero(emissive).astype(np.int32)
     radiance = shaders.emission[mat_index[emit_tri]]
     varies = (shaders.flags[mat_index[emit_tri]] & MF_EMISSION_VARIES) != 0
@@ -216,7 +218,8 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         estimates = np.zeros((int(varies.sum()), 3))
         emission_estimates(sc, alloc_scratch(sc), emit_tri[varies], estimates)
         radiance[varies] = np.maximum(estimates, 0.0)
-    emit_power = radiance.mean(axis=1) * math.pi * areas_and_normals(verts, tris[emit_tri])[0]
+    emit_area = candidate_area[np.searchsorted(candidates, emit_tri)]   # emit_tri is among them
+    emit_power = radiance.mean(axis=1) * math.pi * emit_area
     tri_light = none_i       # no emissive triangle: no table (4 bytes per triangle)
     if len(emit_tri):
         tri_light = np.full(len(tris), -1, np.int32)

@@ -39,7 +39,7 @@ from mcengine.kernels.state import (
 )
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
 from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
-from mcengine.parallel import map_threads
+from mcengine.parallel import map_threads, take
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
 from mcengine.shaders import (
     DEFAULT_COLOR_ATTRIBUTE,
@@ -86,7 +86,7 @@ _BLOCK = 1 << 15
 class LocalMesh:
     """One evaluated mesh in object space, ready to be instanced.
 
-    vertices        (V, 3) float64  vertex positions
+    vertices        (V, 3) float32  vertex positions
     triangles       (T, 3) int32    vertex indices per triangle
     normals         CornerTable (C = 3) shading normals (per vertex, face or corner: the
                     mesh's normals domain)
@@ -359,11 +359,11 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         corner_verts = _corner_vertices(me)
         vertices = _get(me.vertices, "co", np.float32, len(me.vertices) * 3).reshape(-1, 3)
         loops, polygons = _corner_triangles(me, corner_verts, vertices)
-        triangles = np.take(corner_verts, loops).reshape(t, 3)
+        triangles = take(corner_verts, loops).reshape(t, 3)
         corners = loops.reshape(t, 3)
         normals = _shading_normals(me, vertices, corners, triangles, polygons)
+        mat = _triangle_materials(me, slot_materials, polygons)
         uv_layer = _render_uv_layer(me)
-        slot = _polygon_material_index(me)[polygons]
         attributes = _corner_attributes(me, corners, triangles, polygons, wanted)
         attributes.update(_derived_attributes(me, vertices, triangles, polygons, wanted))
         tangents_failed = _add_tangents(me, vertices, triangles, normals, tangents, uv_layer,
@@ -371,12 +371,7 @@ def read_local_mesh(ob, slot_materials, wanted=(), tangents=()) -> LocalMesh | N
         texspace = _texspace(ob)
     finally:
         ob.to_mesh_clear()
-    if slot_materials:
-        # Cycles clamps out-of-range material indices to the last slot.
-        mat = np.asarray(slot_materials, np.int32)[np.clip(slot, 0, len(slot_materials) - 1)]
-    else:
-        mat = np.zeros(t, np.int32)
-    return LocalMesh(vertices=vertices.astype(np.float64), triangles=triangles, normals=normals,
+    return LocalMesh(vertices=vertices, triangles=triangles, normals=normals,
                      material_index=mat, attributes=attributes,
                      uv_name=None if uv_layer is None else uv_layer.name, texspace=texspace,
                      tangents_failed=tangents_failed)
@@ -488,6 +483,15 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
     out.object_texspace[o0:o0 + n] = mesh.texspace
     per_block = max(1, _BLOCK // max(t, 1))          # whole instances per block
     step = max(t, 1) if per_block > 1 else _BLOCK   # or triangles of one instance per block
+    if per_block == 1 and len(mesh.normals.table) < 3 * t:
+        # A large mesh with vertex or face normals: each instance's normals are transformed
+        # once per row of the table, not once per triangle corner.
+        for i in range(n):
+            unit = _unit_normal_table(mesh.normals.table, cof[i])
+            map_threads(lambda a0: _transform_block(mesh, out, pos, cof[i:i + 1], flip[i:i + 1], i,
+                                                    a0, min(t, a0 + step), t0, v0, unit),
+                        range(0, t, step))
+        return
     blocks = [(i0, min(n, i0 + per_block), a0) for i0 in range(0, n, per_block)
               for a0 in range(0, t, step)]
     # The blocks write disjoint rows of ``out``: on threads (numpy releases the GIL).
@@ -495,13 +499,34 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
                                            b[2], min(t, b[2] + step), t0, v0), blocks)
 
 
-def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0):
+def _unit_normal_table(table, cof):
+    """(K, 3) float32: the rows of a mesh's normal table transformed by one instance's ``cof``
+    and normalised, each row as :func:`_transform_block` computes it for a corner; None if
+    a row has zero length (a corner there takes its triangle's normal)."""
+    unit = np.empty(table.shape, np.float32)
+
+    def block(lo):
+        rows = np.matmul(table[lo:lo + _BLOCK].astype(np.float64)[None], cof[None].transpose(0, 2, 1))[0]
+        length = lengths(rows)
+        if not length.all():
+            return False
+        unit[lo:lo + _BLOCK] = rows / length[:, None]
+        return True
+
+    return unit if all(map_threads(block, range(0, len(table), _BLOCK))) else None
+
+
+def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0, unit=None):
     """Triangles a0..a1-1 of instances i0..i0+k-1 (k = len(cof)) into ``out`` at rows
     t0 + [i0*T + a0, (i0+k-1)*T + a1), contiguous because a block is either one
-    instance's range or whole instances; ``pos`` holds the instances' vertices."""
+    instance's range or whole instances; ``pos`` holds the instances' vertices, ``unit`` (one
+    instance) its normal table already transformed (:func:`_unit_normal_table`)."""
     k, v, t = len(cof), mesh.vertices.shape[0], mesh.triangles.shape[0]
-    normals = np.matmul(mesh.normals.corners(a0, a1).reshape(1, -1, 3).astype(np.float64),
-                        cof.transpose(0, 2, 1)).reshape(k, a1 - a0, 3, 3)
+    if unit is None:
+        normals = np.matmul(mesh.normals.corners(a0, a1).reshape(1, -1, 3).astype(np.float64),
+                            cof.transpose(0, 2, 1)).reshape(k, a1 - a0, 3, 3)
+    else:
+        normals = np.take(unit, mesh.normals.index[a0:a1], axis=0)[None]
     tris = np.broadcast_to(mesh.triangles[a0:a1], (k, a1 - a0, 3)) + \
         (np.arange(i0, i0 + k) * v)[:, None, None]
     rows = slice(t0 + i0 * t + a0, t0 + (i0 + k - 1) * t + a1)
@@ -520,7 +545,8 @@ def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0):
             out.uvs[rows] = corners
     tris = tris.reshape(-1, 3)
     out.triangles[rows] = tris + v0
-    out.normals[rows] = _unit_normals(normals.reshape(-1, 3, 3), pos, tris)
+    out.normals[rows] = normals.reshape(-1, 3, 3) if unit is not None else \
+        _unit_normals(normals.reshape(-1, 3, 3), pos, tris)
 
 
 def _unit_normals(normals, pos, tris):
@@ -581,9 +607,17 @@ def _polygon_values(me, name, dtype):
     return _get(attr.data, "value", dtype, len(me.polygons))
 
 
-def _polygon_material_index(me):
-    """Material slot of every polygon, (P,) int32."""
-    return _polygon_values(me, "material_index", np.int32)
+def _triangle_materials(me, slot_materials, polygons):
+    """(T,) int32 scene material of every triangle, from its face's material slot.
+
+    Cycles clamps out-of-range slot indices to the last slot, so a mesh with one slot or
+    none (material 0) needs no face's index; otherwise each face's material is worked out
+    once, then read per triangle.
+    """
+    if len(set(slot_materials)) <= 1:
+        return np.full(len(polygons), slot_materials[0] if slot_materials else 0, np.int32)
+    slot = np.clip(_polygon_values(me, "material_index", np.int32), 0, len(slot_materials) - 1)
+    return take(np.asarray(slot_materials, np.int32)[slot], polygons)
 
 
 def _shading_normals(me, vertices, corners, triangles, polygons) -> CornerTable:

@@ -288,8 +288,9 @@ def test_multi_material_mesh_and_material_table(scene, fake_session):
     verts = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (2, 0, 0), (3, 0, 0), (2, 1, 0), (4, 0, 0), (5, 0, 0), (4, 1, 0)]
     ob = new_mesh_object("Multi", verts, [(0, 1, 2), (3, 4, 5), (6, 7, 8)], materials=[red, green])
     ob.data.materials.append(None)  # an empty third slot
-    ob.data.polygons.foreach_set("material_index", [1, 0, 2])
+    ob.data.polygons.foreach_set("material_index", [1, 0, 7])   # 7: the last slot
     other = new_mesh_object("Other", TRI, [(0, 1, 2)], materials=[green])
+    other.data.polygons.foreach_set("material_index", [4])   # out of range: the last slot
     other.location = (0, 5, 0)
     new_mesh_object("Bare", TRI, [(0, 1, 2)]).location = (0, 9, 0)
     desc = export_scene(fake_session)
@@ -552,6 +553,32 @@ def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, a
     np.testing.assert_array_equal(g.uvs[:grid_tris], g.attributes["Second"][:grid_tris])
     assert not np.any(g.uvs[grid_tris:]) and not any(np.any(a[grid_tris:]) for a in g.attributes.values())
     np.testing.assert_array_equal(g.object_info[-1, 1], 3.0)
+
+
+def test_zero_vertex_normals_become_the_triangles_normal_with_blocks_of_any_size(
+        scene, fake_session, addon, monkeypatch):
+    """Normals are transformed once per corner (whole instances in a block) or once per
+    row of the mesh's normal table (a large mesh in ranges of triangles); both give the
+    same bytes, and a vertex Blender gives no normal (on a triangle whose corners lie on a
+    line) takes its triangle's geometric normal there, +z when it has none either."""
+    n = 4
+    verts = [(x, y, 0.1 * ((x + 2 * y) % 3)) for y in range(n + 1) for x in range(n + 1)]
+    quads = [(y * (n + 1) + x, y * (n + 1) + x + 1, (y + 1) * (n + 1) + x + 1, (y + 1) * (n + 1) + x)
+             for y in range(n) for x in range(n)]
+    v0 = len(verts)
+    ob = new_mesh_object("Grid", verts + [(6, 0, 0), (7, 0, 0), (8, 0, 0)], quads + [(v0, v0 + 1, v0 + 2)])
+    ob.data.shade_smooth()
+    assert not any(ob.data.vertex_normals[v0].vector)              # Blender's zero normal
+    ob.rotation_euler, ob.scale = (0.4, 0.2, 0.1), (1, -2, 1)
+    mesh_module = importlib.import_module(f"{addon.__name__}.export.mesh")
+    normals = {}
+    for block in (1 << 20, 5):              # whole instances per block; ranges of triangles
+        monkeypatch.setattr(mesh_module, "_BLOCK", block)
+        normals[block] = export_scene(fake_session).geometry.normals
+    assert normals[5].tobytes() == normals[1 << 20].tobytes()
+    np.testing.assert_allclose(np.linalg.norm(normals[5], axis=-1), 1.0, rtol=1e-6)
+    line = normals[5][-1]                   # the collinear triangle, last
+    assert any(np.array_equal(c, [0.0, 0.0, 1.0]) for c in line)
 
 
 def _normal_map_material(uv_map=""):

@@ -200,7 +200,7 @@ def detect(scene, emissive_triangles: int, lamp_power, material_flags, programs=
         world = (bool(np.max(np.asarray(scene.world.color, float)) > 0.0), False, False)
     world_lit, world_shader, world_sampled = world
     lamps = [li for li, pw in zip(scene.lights, lamp_power) if pw > 0.0]
-    used = sorted(set(np.unique(scene.geometry.material_index).tolist()))
+    used = scene.geometry.materials_used()
     kinds = set()
     for i in used:
         kinds |= surface_kinds(scene.materials[i])

@@ -106,7 +106,7 @@ from .passes import kernel_data, motion_corners, world_to_raster
 from .scene import DEFAULT_TERMINATOR_OFFSETS, SceneDescription
 from .shaders import AttributeLayout, ShaderTable
 from .sky import sky_images, sun_guide
-from .vectors import cross, lengths
+from .vectors import bounds, cross, lengths
 
 LOCAL_PICK_MAX_LAMPS = 32     # beyond, lights are picked by power (the scan would cost more)
 
@@ -142,7 +142,7 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
     g = scene.geometry
     verts = g.vertices.astype(np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
-    lo, hi = (verts.min(axis=0), verts.max(axis=0)) if len(tris) else (np.zeros(3), np.zeros(3))
+    lo, hi = bounds(verts) if len(tris) else (np.zeros(3), np.zeros(3))
     lamp_pos = [np.asarray(li.matrix_world, float)[:3, 3] for li in scene.lights if li.type != "SUN"]
     if lamp_pos:
         lo = np.minimum(lo, np.min(lamp_pos, axis=0))
@@ -238,8 +238,8 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
     emit_tree = no_tree()
     if len(emit_tri):
         corners = verts[tris[emit_tri]]
-        emit_group = sphere_rows(corners.reshape(-1, 3).min(axis=0)[None],
-                                 corners.reshape(-1, 3).max(axis=0)[None],
+        lo_emit, hi_emit = bounds(corners.reshape(-1, 3))
+        emit_group = sphere_rows(lo_emit[None], hi_emit[None],
                                  np.array([emit_power.sum() / math.pi]))
         slots = sc.motion.tri_slot
         if not (len(slots) and np.any(slots[emit_tri] >= 0)):
@@ -267,7 +267,7 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         if plan.subsurface:
             walked += [i for i, mat in enumerate(scene.materials) if "subsurface" in surface_kinds(mat)]
         scene_ids = None
-        if set(materials_with_node(programs, "AmbientOcclusion")) & set(np.unique(mat_index).tolist()):
+        if set(materials_with_node(programs, "AmbientOcclusion")) & set(g.materials_used()):
             visibility = scene.geometry.triangle_visibility()
             scene_ids = np.arange(len(tris), dtype=np.int32) if visibility is None else \
                 np.flatnonzero(visibility & VIS_SHADOW).astype(np.int32)

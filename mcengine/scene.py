@@ -187,6 +187,13 @@ class Geometry:
             return None
         return visibility[np.clip(self.object_index, 0, len(visibility) - 1)]
 
+    def materials_used(self) -> list[int]:
+        """The material indices some triangle has, ascending (a count per material, not a
+        sort: ``np.unique`` of 4 million indices took 0.4 s)."""
+        if not self.num_triangles:
+            return []
+        return np.flatnonzero(np.bincount(np.asarray(self.material_index).ravel())).tolist()
+
     def object_pass_info(self) -> list:
         """An :class:`ObjectPassInfo` per entry of ``object_names``."""
         if len(self.object_passes) == len(self.object_names):

@@ -18,7 +18,7 @@ import pytest
 from mcengine import memory
 from mcengine.film import Film
 from mcengine.kernels.state import alloc_scratch
-from mcengine.scene import Light, SceneDescription, SceneError
+from mcengine.scene import Geometry, Light, SceneDescription, SceneError
 from mcengine.session import RenderSession, _Buffers
 
 from .scenes import inside_sphere_scene, plane_scene, translation
@@ -193,3 +193,13 @@ def test_film_read_out_is_exact_and_flips_without_copies():
     np.testing.assert_array_equal(flipped, img[::-1])
     plain = (film.sum / np.maximum(film.count, 1)[:, None]).astype(np.float32)
     np.testing.assert_array_equal(film.image().reshape(-1, 4), plain)
+
+
+def test_materials_used_are_those_some_triangle_has():
+    """Ascending, each once, whatever the order and gaps of the triangles' indices; none
+    without triangles."""
+    positions = np.zeros((6, 3, 3))
+    g = Geometry.from_triangles(positions, material_index=np.array([4, 1, 4, 0, 1, 4]))
+    assert g.materials_used() == [0, 1, 4]
+    assert Geometry.from_triangles(positions[:1], material_index=np.array([2])).materials_used() == [2]
+    assert Geometry().materials_used() == []

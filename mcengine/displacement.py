@@ -99,9 +99,10 @@ def displace(scene: SceneDescription, images: ImageTable | None = None) -> Scene
         frames = (inverse[vertex_object], np.linalg.inv(matrix[:, :3, :3]).transpose(0, 2, 1)[vertex_object])
     else:
         frames = None
-    shading = _recomputed_normals(vertices, tris, np.asarray(g.normals, np.float32), smooth, recompute,
-                                  frames)
-    geometry = dataclasses.replace(before, vertices=vertices.astype(np.float32), normals=shading)
+    shading = _recomputed_normals(vertices, tris, g.corner_normals(), smooth, recompute, frames)
+    # Per corner (T, 3, 3): the geometry makes them a table of 3T rows (normal_index=None).
+    geometry = dataclasses.replace(before, vertices=vertices.astype(np.float32), normals=shading,
+                                   normal_index=None)
     changes = {"geometry": geometry}
     for name in ("motion_blur", "motion_vectors"):
         motion = getattr(scene, name)
@@ -117,7 +118,7 @@ def _vertex_normals(g: Geometry, matrix, obj, corner_tri, corner) -> np.ndarray:
     carried by the inverse transpose of their object's matrix, else the shading normals."""
     exported = g.attributes.get(VERTEX_NORMAL_ATTRIBUTE)
     if exported is None or not len(matrix):
-        n = np.asarray(g.normals, np.float64)[corner_tri, corner]
+        n = np.asarray(g.normals, np.float64)[g.normal_index[corner_tri, corner]]
     else:
         n = np.asarray(exported, np.float64)[corner_tri, corner]
         inverse_t = np.linalg.inv(matrix[:, :3, :3]).transpose(0, 2, 1)
@@ -132,7 +133,7 @@ def _object_normals(g: Geometry, matrix, obj) -> np.ndarray:
     exported = g.attributes.get(VERTEX_NORMAL_ATTRIBUTE)
     if exported is not None:
         return np.asarray(exported, np.float32)
-    n = np.asarray(g.normals, np.float64)
+    n = g.corner_normals().astype(np.float64)
     if len(matrix):
         n = np.einsum("tji,tkj->tki", matrix[obj, :3, :3], n)       # M^T n
     return _unit(n).astype(np.float32)
@@ -159,8 +160,8 @@ def _evaluate(scene: SceneDescription, g: Geometry, corner_tri, corner, normals,
     verts = np.asarray(g.vertices, np.float64)
     tris = np.ascontiguousarray(g.triangles, np.int32)
     _area, ng = areas_and_normals(verts, tris)
-    shading = np.ascontiguousarray(g.normals, np.float32)
-    tex = TextureData(attr=attr, normals=shading,
+    tex = TextureData(attr=attr, normals=np.ascontiguousarray(g.normals, np.float32),
+                      normal_index=np.ascontiguousarray(g.normal_index, np.int32),
                       tri_object=np.ascontiguousarray(g.object_index, np.int32),
                       objects=pack_objects(g), camera=pack_camera(scene.camera, scene.film, scene.motion_blur),
                       images=images.info, pix8=images.pix8, pixf=images.pixf)
@@ -178,7 +179,7 @@ def _smooth(g: Geometry) -> np.ndarray:
     flag = g.attributes.get(SMOOTH_ATTRIBUTE)
     if flag is not None:
         return np.asarray(flag)[:, 0, 0] > 0.5
-    n = np.asarray(g.normals, np.float32)
+    n = g.corner_normals()
     return np.abs(n - n[:, :1]).max(axis=(1, 2)) > 1e-6
 
 

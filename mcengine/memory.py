@@ -27,8 +27,9 @@ from pathlib import Path
 # the index of pixels still sampling (int32).
 FILM_BYTES_PER_PIXEL = 4 * 8 + 3 * 8 + 4 + 4
 IMAGE_BYTES_PER_PIXEL = 4 * 4                  # float32 RGBA handed to the host at each pass
-# Packed tables per triangle (vertices f64, indices, normals, uvs, material, areas,
-# normals f64, ~140 B) and Embree's BVH in robust mode (~130 B, measured with embreex).
+# Packed tables per triangle, an upper bound (vertices f32 and f64, indices, shading normals
+# at most one per corner with their index, uvs, material and object indices: at most
+# ~140 B) and Embree's BVH in robust mode (~130 B, measured with embreex).
 BYTES_PER_TRIANGLE = 270
 # Headroom for the interpreter's own growth while rendering.
 SLACK_BYTES = 64 << 20

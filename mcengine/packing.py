@@ -160,9 +160,8 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
     film = scene.film
     camera = pack_camera(scene.camera, film, scene.motion_blur)
     none_f, none_i = np.zeros(0), np.zeros(0, np.int32)
-    normals = np.ascontiguousarray(g.normals, np.float32)
     sc = SceneData(
-        verts=verts, tris=tris, normals=normals,
+        verts=verts, tris=tris,
         mat_index=mat_index, svm_ops=shaders.ops, svm_regs=shaders.registers,
         mat_prog=shaders.ranges, mat_emission=shaders.emission, mat_flags=shaders.flags,
         lamps=np.zeros((0, LIGHT_STRIDE)), ies=np.zeros(1), light_cdf=np.zeros(1), emit_tri=none_i, emit_pmf=none_f,
@@ -170,7 +169,8 @@ def pack_scene(scene: SceneDescription, force_effects=(), images: ImageTable | N
         tri_light=none_i,
         world=shaders.emission[world].copy(), camera=camera,
         filter_table=filter_table(film.filter_type, film.filter_width),
-        tex=TextureData(attr=attr, normals=normals,
+        tex=TextureData(attr=attr, normals=np.ascontiguousarray(g.normals, np.float32),
+                        normal_index=np.ascontiguousarray(g.normal_index, np.int32),
                         tri_object=np.ascontiguousarray(g.object_index, np.int32),
                         objects=pack_objects(g), camera=camera, images=images.info,
                         pix8=images.pix8, pixf=images.pixf),

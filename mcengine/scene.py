@@ -81,9 +81,13 @@ class Geometry:
 
     vertices        (V, 3) float32  vertex positions
     triangles       (T, 3) int32    vertex indices of each triangle
-    normals         (T, 3, 3) float32  shading normal at each corner (unit length; after true
-                    displacement of a stretched object, the length its normal matrix gives
-                    them: ``displacement``)
+    normals         (K, 3) float32  shading normals (unit length; after true displacement of
+                    a stretched object, the length its normal matrix gives them:
+                    ``displacement``), one per vertex, face or corner as the mesh has them
+    normal_index    (T, 3) int32    the row of ``normals`` of each triangle corner (for
+                    vertex normals it is ``triangles`` itself: no copy).  Given per corner,
+                    (T, 3, 3), ``normals`` become K = 3T rows and this index is made;
+                    ``corner_normals`` gives them per corner
     uvs             (T, 3, 2) float32  UV at each corner (zeros if the mesh has none)
     material_index  (T,) int32      index into ``SceneDescription.materials``
     object_index    (T,) int32      index into ``object_names`` (for messages)
@@ -112,7 +116,7 @@ class Geometry:
 
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
     triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int32))
-    normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 3), np.float32))
+    normals: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
     uvs: np.ndarray = field(default_factory=lambda: np.zeros((0, 3, 2), np.float32))
     material_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
     object_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int32))
@@ -126,6 +130,18 @@ class Geometry:
     object_visibility: np.ndarray | None = None
     object_receiver_set: np.ndarray | None = None
     object_light_sets: np.ndarray | None = None
+    normal_index: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.normal_index is None:
+            normals = np.asarray(self.normals)
+            t = len(self.triangles)
+            self.normals = normals.reshape(-1, 3)
+            self.normal_index = np.arange(3 * t, dtype=np.int32).reshape(t, 3)
+
+    def corner_normals(self) -> np.ndarray:
+        """(T, 3, 3) the shading normal at each triangle corner (a new array)."""
+        return np.take(self.normals, self.normal_index, axis=0)
 
     @property
     def num_objects(self) -> int:
@@ -262,6 +278,8 @@ class Geometry:
         return Geometry(
             vertices=np.concatenate(verts), triangles=np.concatenate(tris),
             normals=np.concatenate([g.normals for g in parts]),
+            normal_index=np.concatenate([g.normal_index + k for g, k in
+                                         zip(parts, np.cumsum([0] + [len(g.normals) for g in parts]))]),
             uvs=np.concatenate([g.uvs for g in parts]),
             material_index=np.concatenate([g.material_index for g in parts]),
             object_index=np.concatenate(objs), object_names=names, attributes=attributes,
@@ -676,7 +694,7 @@ class SceneDescription:
         if g.vertices.ndim != 2 or g.vertices.shape[1] != 3:
             raise SceneError(f"geometry.vertices must be (V, 3), got {g.vertices.shape}")
         for name, arr, shape in (("triangles", g.triangles, (t, 3)),
-                                 ("normals", g.normals, (t, 3, 3)),
+                                 ("normal_index", g.normal_index, (t, 3)),
                                  ("uvs", g.uvs, (t, 3, 2)),
                                  ("material_index", g.material_index, (t,)),
                                  ("object_index", g.object_index, (t,))):
@@ -684,6 +702,10 @@ class SceneDescription:
                 raise SceneError(f"geometry.{name} has shape {arr.shape}, expected {shape}")
         if t and (g.triangles.min() < 0 or g.triangles.max() >= g.vertices.shape[0]):
             raise SceneError("geometry.triangles refers to vertices that do not exist")
+        if g.normals.ndim != 2 or g.normals.shape[1] != 3:
+            raise SceneError(f"geometry.normals must be (K, 3), got {g.normals.shape}")
+        if t and (g.normal_index.min() < 0 or g.normal_index.max() >= g.normals.shape[0]):
+            raise SceneError("geometry.normal_index refers to normals that do not exist")
         for name in ("vertices", "normals", "uvs"):
             if not np.all(np.isfinite(getattr(g, name))):
                 raise SceneError(f"geometry.{name} contains NaN or infinite values")
@@ -871,6 +893,7 @@ class SceneDescription:
         images = {f"image{k}": im.pixels for k, im in enumerate(self.images.values())}
         np.savez_compressed(
             path, vertices=g.vertices, triangles=g.triangles, normals=g.normals,
+            normal_index=g.normal_index,
             uvs=g.uvs, material_index=g.material_index, object_index=g.object_index,
             object_matrix=matrix, object_texspace=texspace, object_info=info,
             object_terminator=g.terminator_offsets(), object_visibility=g.visibility(),
@@ -914,7 +937,7 @@ _SAVED_ARRAYS = {
 _OPTIONAL_ARRAYS = {"object_matrix": ("f", (4, 4)), "object_texspace": ("f", (2, 3)),
                     "object_info": ("f", (6,)), "object_terminator": ("f", (2,)),
                     "object_visibility": ("iu", ()), "object_receiver_set": ("iu", ()),
-                    "object_light_sets": ("iu", ())}
+                    "object_light_sets": ("iu", ()), "normal_index": ("iu", (3,))}
 MAX_META_BYTES = 64 << 20
 
 
@@ -924,6 +947,8 @@ def _read_arrays(archive: zipfile.ZipFile, path: Path) -> dict:
     present = {name[:-4] for name in archive.namelist() if name.endswith(".npy")}
     expected = dict(_SAVED_ARRAYS)
     expected.update({n: spec for n, spec in _OPTIONAL_ARRAYS.items() if n in present})
+    if "normal_index" in present:            # normals a table (K, 3); older files: per corner
+        expected["normals"] = ("f", (3,))
     for name in present:
         if name.startswith("attribute"):
             expected[name] = ("f", None)
@@ -958,6 +983,7 @@ def _from_saved(z: dict, meta: dict) -> "SceneDescription":
     """Build the description from the arrays and the JSON metadata of a saved file."""
     names = list(meta.get("attributes", []))
     geom = Geometry(vertices=z["vertices"], triangles=z["triangles"], normals=z["normals"],
+                    normal_index=z.get("normal_index"),
                     uvs=z["uvs"], material_index=z["material_index"],
                     object_index=z["object_index"], object_names=list(meta["object_names"]),
                     attributes={str(name): z[f"attribute{k}"] for k, name in enumerate(names)},

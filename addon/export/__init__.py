@@ -261,7 +261,7 @@ def _sample_layout(ctx, depsgraph, frame_set, shutter, layout):
 
     def place(local, matrix):
         placed = mesh.transform_instances(local, matrix[None], s, [""])
-        return placed.vertices, placed.normals
+        return placed.vertices, placed.corner_normals()
 
     ob = depsgraph.scene.camera.evaluated_get(depsgraph)
     camera_steps = motion.motion_steps(ob.original)

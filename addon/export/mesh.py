@@ -419,6 +419,10 @@ def _place_all(parts, unit_scale: float) -> Geometry:
     ``Geometry.concatenate`` of their :func:`transform_instances` would give it (an
     attribute some mesh lacks is zero there), but with one allocation of the final
     arrays and every instance written in place (no per-part arrays, no concatenation copy).
+
+    Each instance's shading normals are its mesh's normal table (per vertex, face or corner)
+    transformed and normalised once per row (:func:`_normal_rows`); when every mesh has
+    vertex normals, the geometry's ``normal_index`` is its ``triangles`` array itself.
     """
     if not parts:
         return Geometry()
@@ -429,10 +433,17 @@ def _place_all(parts, unit_scale: float) -> Geometry:
     t_all = sum(len(m) * mesh.triangles.shape[0] for mesh, m, _n, _i in parts)
     v_all = sum(len(m) * mesh.vertices.shape[0] for mesh, m, _n, _i in parts)
     o_all = sum(len(m) for _mesh, m, _n, _i in parts)
+    per_corner = [_per_corner_normals(mesh, m) for mesh, m, _n, _i in parts]
+    k_all = sum(len(m) * (3 * mesh.triangles.shape[0] if corner else len(mesh.normals.table))
+                for (mesh, m, _n, _i), corner in zip(parts, per_corner))
+    triangles = np.empty((t_all, 3), np.int32)
+    shared = not any(per_corner) and all(mesh.normals.index is mesh.triangles
+                                         for mesh, _m, _n, _i in parts)
     # Zeros only where values may be missing (untouched zero pages cost no memory).
     out = Geometry(vertices=np.empty((v_all, 3), np.float32),
-                   triangles=np.empty((t_all, 3), np.int32),
-                   normals=np.empty((t_all, 3, 3), np.float32),
+                   triangles=triangles,
+                   normals=np.empty((k_all, 3), np.float32),
+                   normal_index=triangles if shared else np.empty((t_all, 3), np.int32),
                    uvs=np.zeros((t_all, 3, 2), np.float32),
                    material_index=np.empty(t_all, np.int32),
                    object_index=np.empty(t_all, np.int32),
@@ -440,10 +451,10 @@ def _place_all(parts, unit_scale: float) -> Geometry:
                    attributes={name: np.zeros((t_all, 3, c), np.float32) for name, c in sizes.items()},
                    object_matrix=np.empty((o_all, 4, 4)), object_texspace=np.empty((o_all, 2, 3)),
                    object_info=np.zeros((o_all, 6)))
-    t0 = v0 = o0 = 0
-    for mesh, matrices, _names, infos in parts:
+    t0 = v0 = n0 = o0 = 0
+    for (mesh, matrices, _names, infos), corner in zip(parts, per_corner):
         n = len(matrices)
-        _place_instances(mesh, matrices, unit_scale, out, t0, v0, o0)
+        n0 = _place_instances(mesh, matrices, unit_scale, out, t0, v0, n0, o0, corner, shared)
         if infos is not None:
             out.object_info[o0:o0 + n] = np.asarray(infos, np.float64).reshape(n, 6)
         t0 += n * mesh.triangles.shape[0]
@@ -452,10 +463,22 @@ def _place_all(parts, unit_scale: float) -> Geometry:
     return out
 
 
+def _per_corner_normals(mesh: LocalMesh, matrices) -> bool:
+    """Whether a mesh's instances get a normal per triangle corner instead of transformed rows
+    of its table: when a row of the table, or of its transformed copy under a singular
+    matrix, has zero length (such a corner takes its triangle's normal, ``_unit_normals``)."""
+    table = mesh.normals.table
+    if len(table) and not lengths(table).all():
+        return True
+    return bool(np.any(np.linalg.det(np.asarray(matrices, np.float64)[:, :3, :3]) == 0.0))
+
+
 def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry, t0: int, v0: int,
-                     o0: int) -> None:
-    """Write N instances of ``mesh`` into ``out`` from triangle t0, vertex v0 and object o0 on
-    (see :func:`transform_instances`; Object Info is left to the caller).
+                     n0: int, o0: int, per_corner: bool, shared: bool) -> int:
+    """Write N instances of ``mesh`` into ``out`` from triangle t0, vertex v0, normal row n0 and
+    object o0 on (see :func:`transform_instances`; Object Info is left to the caller); returns
+    the normal row after them. ``per_corner``: a normal row per triangle corner
+    (``_per_corner_normals``); ``shared``: ``out.normal_index`` is ``out.triangles``.
 
     The per-triangle arrays are computed in blocks of about ``_BLOCK`` triangles (a
     range of one instance's triangles, or several whole instances) written straight
@@ -481,59 +504,68 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
     out.object_matrix[o0:o0 + n] = m
     out.object_matrix[o0:o0 + n, :3, :] *= unit_scale
     out.object_texspace[o0:o0 + n] = mesh.texspace
+    rows = 3 * t if per_corner else len(mesh.normals.table)      # normal rows per instance
+    if not per_corner:
+        _normal_rows(mesh.normals.table, cof, out.normals[n0:n0 + n * rows])
     per_block = max(1, _BLOCK // max(t, 1))          # whole instances per block
     step = max(t, 1) if per_block > 1 else _BLOCK   # or triangles of one instance per block
-    if per_block == 1 and len(mesh.normals.table) < 3 * t:
-        # A large mesh with vertex or face normals: each instance's normals are transformed
-        # once per row of the table, not once per triangle corner.
-        for i in range(n):
-            unit = _unit_normal_table(mesh.normals.table, cof[i])
-            map_threads(lambda a0: _transform_block(mesh, out, pos, cof[i:i + 1], flip[i:i + 1], i,
-                                                    a0, min(t, a0 + step), t0, v0, unit),
-                        range(0, t, step))
-        return
     blocks = [(i0, min(n, i0 + per_block), a0) for i0 in range(0, n, per_block)
               for a0 in range(0, t, step)]
     # The blocks write disjoint rows of ``out``: on threads (numpy releases the GIL).
     map_threads(lambda b: _transform_block(mesh, out, pos, cof[b[0]:b[1]], flip[b[0]:b[1]], b[0],
-                                           b[2], min(t, b[2] + step), t0, v0), blocks)
+                                           b[2], min(t, b[2] + step), t0, v0, n0, rows,
+                                           per_corner, shared), blocks)
+    return n0 + n * rows
 
 
-def _unit_normal_table(table, cof):
-    """(K, 3) float32: the rows of a mesh's normal table transformed by one instance's ``cof``
-    and normalised, each row as :func:`_transform_block` computes it for a corner; None if
-    a row has zero length (a corner there takes its triangle's normal)."""
-    unit = np.empty(table.shape, np.float32)
+def _normal_rows(table, cof, out):
+    """``out`` (N K, 3) float32: the rows of a mesh's normal table (K, 3) transformed by each of
+    N instances' ``cof`` and normalised, as :func:`_unit_normals` computes them for a corner
+    (no row has zero length: ``_per_corner_normals``); in blocks on threads."""
+    k_rows = len(table)
+    per_block = max(1, _BLOCK // max(k_rows, 1))     # whole instances per block
+    step = max(k_rows, 1) if per_block > 1 else _BLOCK
+    blocks = [(i0, min(len(cof), i0 + per_block), r0) for i0 in range(0, len(cof), per_block)
+              for r0 in range(0, k_rows, step)]
 
-    def block(lo):
-        rows = np.matmul(table[lo:lo + _BLOCK].astype(np.float64)[None], cof[None].transpose(0, 2, 1))[0]
-        length = lengths(rows)
-        if not length.all():
-            return False
-        unit[lo:lo + _BLOCK] = rows / length[:, None]
-        return True
+    def block(b):
+        i0, i1, r0 = b
+        r1 = min(k_rows, r0 + step)
+        rows = np.matmul(table[r0:r1].astype(np.float64)[None], cof[i0:i1].transpose(0, 2, 1))
+        rows = rows / lengths(rows)[..., None]
+        if i1 - i0 == 1:
+            out[i0 * k_rows + r0:i0 * k_rows + r1] = rows[0]
+        else:
+            out[i0 * k_rows:i1 * k_rows] = rows.reshape(-1, 3)
 
-    return unit if all(map_threads(block, range(0, len(table), _BLOCK))) else None
+    map_threads(block, blocks)
 
 
-def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0, unit=None):
+def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0, n0, rows_per, per_corner,
+                     shared):
     """Triangles a0..a1-1 of instances i0..i0+k-1 (k = len(cof)) into ``out`` at rows
     t0 + [i0*T + a0, (i0+k-1)*T + a1), contiguous because a block is either one
-    instance's range or whole instances; ``pos`` holds the instances' vertices, ``unit`` (one
-    instance) its normal table already transformed (:func:`_unit_normal_table`)."""
+    instance's range or whole instances; ``pos`` holds the instances' vertices.  Normal rows
+    start at n0, ``rows_per`` per instance: with ``per_corner`` this block writes its
+    corners' (three per triangle, in triangle order), else the instances' tables are
+    written already and the block writes where its corners' rows are (unless ``shared``)."""
     k, v, t = len(cof), mesh.vertices.shape[0], mesh.triangles.shape[0]
-    if unit is None:
-        normals = np.matmul(mesh.normals.corners(a0, a1).reshape(1, -1, 3).astype(np.float64),
-                            cof.transpose(0, 2, 1)).reshape(k, a1 - a0, 3, 3)
-    else:
-        normals = np.take(unit, mesh.normals.index[a0:a1], axis=0)[None]
     tris = np.broadcast_to(mesh.triangles[a0:a1], (k, a1 - a0, 3)) + \
         (np.arange(i0, i0 + k) * v)[:, None, None]
     rows = slice(t0 + i0 * t + a0, t0 + (i0 + k - 1) * t + a1)
     any_flip = flip.any()
+    if per_corner:
+        normals = np.matmul(mesh.normals.corners(a0, a1).reshape(1, -1, 3).astype(np.float64),
+                            cof.transpose(0, 2, 1)).reshape(k, a1 - a0, 3, 3)
+    elif not shared:
+        index = np.broadcast_to(mesh.normals.index[a0:a1], (k, a1 - a0, 3)) + \
+            (n0 + np.arange(i0, i0 + k) * rows_per)[:, None, None]
     if any_flip:
         tris[flip] = tris[flip][:, :, _FLIP]
-        normals[flip] = normals[flip][:, :, _FLIP]
+        if per_corner:
+            normals[flip] = normals[flip][:, :, _FLIP]
+        elif not shared:
+            index[flip] = index[flip][:, :, _FLIP]
     for name, values in mesh.attributes.items():
         corners = np.broadcast_to(values.corners(a0, a1), (k, a1 - a0, 3, values.table.shape[1]))
         if any_flip:
@@ -545,8 +577,14 @@ def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0, unit=None):
             out.uvs[rows] = corners
     tris = tris.reshape(-1, 3)
     out.triangles[rows] = tris + v0
-    out.normals[rows] = normals.reshape(-1, 3, 3) if unit is not None else \
-        _unit_normals(normals.reshape(-1, 3, 3), pos, tris)
+    if per_corner:
+        first = n0 + 3 * (i0 * t + a0)           # the block's corners, in triangle order
+        count = 3 * (rows.stop - rows.start)
+        out.normals[first:first + count] = _unit_normals(normals.reshape(-1, 3, 3), pos,
+                                                         tris).reshape(-1, 3)
+        out.normal_index[rows] = np.arange(first, first + count, dtype=np.int32).reshape(-1, 3)
+    elif not shared:
+        out.normal_index[rows] = index.reshape(-1, 3)
 
 
 def _unit_normals(normals, pos, tris):

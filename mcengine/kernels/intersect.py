@@ -279,10 +279,11 @@ def prim_corners(sc, p, time):
 def prim_normals(sc, p, time):
     """The corner shading normals of triangle p at ``time`` (9 floats, world space)."""
     if is_moving(sc, p):
-        return moving_normals(sc.motion, sc.verts, sc.tris, sc.normals, p, time)
-    n = sc.normals
-    return (n[p, 0, 0], n[p, 0, 1], n[p, 0, 2], n[p, 1, 0], n[p, 1, 1], n[p, 1, 2],
-            n[p, 2, 0], n[p, 2, 1], n[p, 2, 2])
+        return moving_normals(sc.motion, sc.verts, sc.tris, sc.tex.normals, sc.tex.normal_index,
+                              p, time)
+    n, ni = sc.tex.normals, sc.tex.normal_index
+    a, b, c = ni[p, 0], ni[p, 1], ni[p, 2]
+    return n[a, 0], n[a, 1], n[a, 2], n[b, 0], n[b, 1], n[b, 2], n[c, 0], n[c, 1], n[c, 2]
 
 
 @device

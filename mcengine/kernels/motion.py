@@ -311,7 +311,7 @@ def pack_motion(geometry, objects) -> MotionData:
     tris = np.asarray(geometry.triangles, np.int64)
     tri_slot = np.full(t, -1, np.int32)
     tri_local = np.full(t, -1, np.int32)
-    n = geometry.normals
+    n = geometry.corner_normals()
     tri_flat = (np.all(n[:, 0] == n[:, 1], axis=1) & np.all(n[:, 0] == n[:, 2], axis=1)).astype(np.uint8)
     info = np.zeros((len(objects), SLOT_INFO), np.int64)
     xforms, positions, normals, roots = [], [], [], []
@@ -564,7 +564,7 @@ def moving_triangle(md, verts, tris, p, time):
 
 
 @function
-def moving_normals(md, verts, tris, normals, p, time):
+def moving_normals(md, verts, tris, normals, normal_index, p, time):
     """The corner shading normals of moving triangle p in world space at ``time`` (9 floats,
     each of unit length): deformation steps interpolated linearly and normalised, as Cycles
     does, then carried by the inverse transpose of A(t); a deforming flat face takes the
@@ -579,9 +579,10 @@ def moving_normals(md, verts, tris, normals, p, time):
         nx, ny, nz = _unit(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
         return nx, ny, nz, nx, ny, nz, nx, ny, nz
     if info[j, SI_NRM] < 0:
-        n0x, n0y, n0z = normals[p, 0, 0], normals[p, 0, 1], normals[p, 0, 2]
-        n1x, n1y, n1z = normals[p, 1, 0], normals[p, 1, 1], normals[p, 1, 2]
-        n2x, n2y, n2z = normals[p, 2, 0], normals[p, 2, 1], normals[p, 2, 2]
+        i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
+        n0x, n0y, n0z = normals[i0, 0], normals[i0, 1], normals[i0, 2]
+        n1x, n1y, n1z = normals[i1, 0], normals[i1, 1], normals[i1, 2]
+        n2x, n2y, n2z = normals[i2, 0], normals[i2, 1], normals[i2, 2]
     else:
         step, f = motion_step(info[j, SI_STEPS], time)
         a = info[j, SI_NRM] + step * info[j, SI_NTRIS] + md.tri_local[p]

@@ -478,7 +478,7 @@ def _walk(sc, st, i, cl, k, p, sp, wix, wiy, wiz, vertex, sampler, mask):
     wkey = walk_key(st.key[i], vertex)
     if cl[k, CL_SSS_METHOD] == SSS_BURLEY:
         left, q, ex, ey, ez, gx, gy, gz, wr, wg, wb = disk_probe(
-            sc.local, sc.verts, sc.tris, sc.normals, obj, sampler, wkey, mask,
+            sc.local, sc.verts, sc.tris, sc.tex.normals, sc.tex.normal_index, obj, sampler, wkey, mask,
             sp.hx, sp.hy, sp.hz, sp.ngx, sp.ngy, sp.ngz, sp.backfacing, cl[k, CL_RADIUS], cl[k, CL_RADIUS + 1],
             cl[k, CL_RADIUS + 2])
         if not left:

@@ -82,8 +82,7 @@ Scratch = namedtuple("Scratch", [
 
 SceneData = namedtuple("SceneData", [
     "verts",         # (V, 3) f64
-    "tris",          # (T, 3) int32
-    "normals",       # (T, 3, 3) f32  shading normals at the corners
+    "tris",          # (T, 3) int32   (the shading normals are in ``tex``: TextureData)
     "mat_index",     # (T,) int32
     "svm_ops",       # (P, 4) int32  every material's shader program (kernels.svm)
     "svm_regs",      # (R,) f64      their registers with the constants in place (each worker

@@ -412,13 +412,13 @@ def random_walk(lb, verts, tris, obj, sampler, wkey, mask, px, py, pz, dx, dy, d
 
 # -- Christensen-Burley: a disk probe ------------------------------------------------------------
 @device
-def _hit_weight(normals, verts, tris, p, hx, hy, hz, px, py, pz, flip, axes, picks, scale,
-                radius, disk_r):
+def _hit_weight(normals, normal_index, verts, tris, p, hx, hy, hz, px, py, pz, flip, axes, picks,
+                scale, radius, disk_r):
     """Weight (r, g, b) of the probe's hit h on triangle p: the profile at its distance
     from p0 = (px, py, pz) over the disk's pdf, times the MIS weight of the disk's axis
     (power heuristic over the three ``axes`` (n, t, b) picked with probabilities ``picks``)
     and ``scale``."""
-    gx, gy, gz = hit_normal(normals, verts, tris, p, flip)
+    gx, gy, gz = hit_normal(normals, normal_index, verts, tris, p, flip)
     pdf_n = picks[0] * abs(axes[0] * gx + axes[1] * gy + axes[2] * gz)
     pdf_t = picks[1] * abs(axes[3] * gx + axes[4] * gy + axes[5] * gz)
     pdf_b = picks[2] * abs(axes[6] * gx + axes[7] * gy + axes[8] * gz)
@@ -429,23 +429,24 @@ def _hit_weight(normals, verts, tris, p, hx, hy, hz, px, py, pz, flip, axes, pic
 
 
 @device
-def hit_normal(normals, verts, tris, p, flip):
+def hit_normal(normals, normal_index, verts, tris, p, flip):
     """Triangle p's geometric normal, on the side its corner normals say, flipped when the
     probe started on a back face."""
     gx, gy, gz, _ = triangle_frame(verts, tris, p)
-    gx, gy, gz = facing_corners(normals, p, gx, gy, gz)
+    gx, gy, gz = facing_corners(normals, normal_index, p, gx, gy, gz)
     if flip:
         gx, gy, gz = -gx, -gy, -gz
     return gx, gy, gz
 
 
 @device
-def facing_corners(normals, p, gx, gy, gz):
+def facing_corners(normals, normal_index, p, gx, gy, gz):
     """The normal g of triangle p, on the side its corner normals say (the object's outside:
-    a mirrored object's winding is reversed)."""
-    sx = normals[p, 0, 0] + normals[p, 1, 0] + normals[p, 2, 0]
-    sy = normals[p, 0, 1] + normals[p, 1, 1] + normals[p, 2, 1]
-    sz = normals[p, 0, 2] + normals[p, 1, 2] + normals[p, 2, 2]
+    a mirrored object's winding is reversed); ``normals[normal_index[p, k]]`` is corner k's."""
+    i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
+    sx = normals[i0, 0] + normals[i1, 0] + normals[i2, 0]
+    sy = normals[i0, 1] + normals[i1, 1] + normals[i2, 1]
+    sz = normals[i0, 2] + normals[i1, 2] + normals[i2, 2]
     if sx * gx + sy * gy + sz * gz < 0.0:
         return -gx, -gy, -gz
     return gx, gy, gz
@@ -501,7 +502,7 @@ def probe(lb, verts, tris, obj, ox, oy, oz, dx, dy, dz, tmax, key):
 
 
 @device
-def disk_probe(lb, verts, tris, normals, obj, sampler, wkey, mask, px, py, pz,
+def disk_probe(lb, verts, tris, normals, normal_index, obj, sampler, wkey, mask, px, py, pz,
                ngx, ngy, ngz, backfacing, rr, rg, rb):
     """Christensen-Burley's exit from point p (geometric normal ng on the viewer's side) of
     object ``obj``, radius r per channel.
@@ -529,18 +530,18 @@ def disk_probe(lb, verts, tris, normals, obj, sampler, wkey, mask, px, py, pz,
     picks = (pick_n, pick_t, pick_b)
     radius = (rr, rg, rb)
     wr1 = wg1 = wb1 = wr2 = wg2 = wb2 = wr3 = wg3 = wb3 = 0.0
-    wr0, wg0, wb0 = _hit_weight(normals, verts, tris, p0, ox + t0 * dx, oy + t0 * dy, oz + t0 * dz,
+    wr0, wg0, wb0 = _hit_weight(normals, normal_index, verts, tris, p0, ox + t0 * dx, oy + t0 * dy, oz + t0 * dz,
                                 px, py, pz, backfacing, axes, picks, scale, radius, disk_r)
     if kept > 1:
-        wr1, wg1, wb1 = _hit_weight(normals, verts, tris, p1, ox + t1 * dx, oy + t1 * dy,
+        wr1, wg1, wb1 = _hit_weight(normals, normal_index, verts, tris, p1, ox + t1 * dx, oy + t1 * dy,
                                     oz + t1 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     if kept > 2:
-        wr2, wg2, wb2 = _hit_weight(normals, verts, tris, p2, ox + t2 * dx, oy + t2 * dy,
+        wr2, wg2, wb2 = _hit_weight(normals, normal_index, verts, tris, p2, ox + t2 * dx, oy + t2 * dy,
                                     oz + t2 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     if kept > 3:
-        wr3, wg3, wb3 = _hit_weight(normals, verts, tris, p3, ox + t3 * dx, oy + t3 * dy,
+        wr3, wg3, wb3 = _hit_weight(normals, normal_index, verts, tris, p3, ox + t3 * dx, oy + t3 * dy,
                                     oz + t3 * dz, px, py, pz, backfacing, axes, picks, scale,
                                     radius, disk_r)
     s0 = abs(wr0 + wg0 + wb0) / 3.0
@@ -560,5 +561,5 @@ def disk_probe(lb, verts, tris, normals, obj, sampler, wkey, mask, px, py, pz,
     else:
         p, t, sw, wr, wg, wb = p3, t3, s3, wr3, wg3, wb3
     k = total / sw
-    gx, gy, gz = hit_normal(normals, verts, tris, p, backfacing)
+    gx, gy, gz = hit_normal(normals, normal_index, verts, tris, p, backfacing)
     return True, p, ox + t * dx, oy + t * dy, oz + t * dz, gx, gy, gz, wr * k, wg * k, wb * k

@@ -34,7 +34,7 @@ def test_triangle_with_known_transform(scene, fake_session):
     g = export_scene(fake_session).geometry
     assert g.num_triangles == 1
     np.testing.assert_allclose(corners(g)[0], [(1, 2, 3), (1, 4, 3), (-1, 2, 3)], atol=1e-6)
-    np.testing.assert_allclose(g.normals[0], [(0, 0, 1)] * 3, atol=1e-6)
+    np.testing.assert_allclose(g.corner_normals()[0], [(0, 0, 1)] * 3, atol=1e-6)
     np.testing.assert_array_equal(g.uvs, np.zeros((1, 3, 2)))
     assert g.material_index.tolist() == [0]
     assert g.object_names == ["Tri"]
@@ -46,7 +46,7 @@ def _check_closed_cube(g, center):
     ng = geometric_normals(g)
     outward = np.einsum("ti,ti->t", ng, p.mean(axis=1) - center)
     assert np.all(outward > 0), "some triangles face inwards"
-    shading = g.normals.astype(np.float64)
+    shading = g.corner_normals().astype(np.float64)
     for k in range(3):
         np.testing.assert_allclose(shading[:, k], ng, atol=1e-5)
 
@@ -76,8 +76,8 @@ def test_normals_use_the_inverse_transpose(scene, fake_session):
     ob = new_mesh_object("Slant", [(0, 0, 0), (1, 0, 0), (0, 1, 1)], [(0, 1, 2)])
     ob.scale = (1, 1, 3)
     g = export_scene(fake_session).geometry
-    np.testing.assert_allclose(g.normals[0, 0], geometric_normals(g)[0], atol=1e-6)
-    np.testing.assert_allclose(g.normals[0, 0], np.array([0, -3, 1]) / math.sqrt(10), atol=1e-6)
+    np.testing.assert_allclose(g.corner_normals()[0, 0], geometric_normals(g)[0], atol=1e-6)
+    np.testing.assert_allclose(g.corner_normals()[0, 0], np.array([0, -3, 1]) / math.sqrt(10), atol=1e-6)
 
 
 def test_smooth_shading_normals(scene, fake_session):
@@ -87,12 +87,79 @@ def test_smooth_shading_normals(scene, fake_session):
     ob.data.shade_smooth()
     g = export_scene(fake_session).geometry
     p = corners(g)
-    n = g.normals.astype(np.float64)
+    n = g.corner_normals().astype(np.float64)
     ridge = np.isclose(p[..., 2], 1)
     np.testing.assert_allclose(n[ridge], np.tile([0, 0, 1], (ridge.sum(), 1)), atol=1e-6)
     left = ~ridge & (p[..., 0] < 0)
     np.testing.assert_allclose(n[left], np.tile(np.array([-1, 0, 1]) / math.sqrt(2), (left.sum(), 1)),
                                atol=1e-6)
+
+
+@pytest.mark.parametrize("shading", ["smooth", "flat"])
+def test_normals_are_stored_once_per_vertex_or_face(scene, fake_session, shading):
+    """Vertex normals take one row per exported vertex and the corners' rows are the triangles
+    themselves (no index of their own); face normals one row per triangle.  A plain and a
+    mirrored cube: each corner gets its own cube's outward normal (smooth: from the cube's
+    centre through the vertex; flat: the face's)."""
+    ob = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)
+    if shading == "smooth":
+        ob.data.shade_smooth()
+    twin = ob.copy()
+    twin.location, twin.scale = (5, 0, 0), (-1, 2, 1)
+    bpy.context.scene.collection.objects.link(twin)
+    g = export_scene(fake_session).geometry
+    n = g.corner_normals().astype(np.float64)
+    if shading == "smooth":
+        assert g.normal_index is g.triangles and len(g.normals) == len(g.vertices) == 16
+    else:
+        assert len(g.normals) == g.num_triangles == 24
+        assert np.all(g.normal_index == g.normal_index[:, :1])
+    for obj, center in enumerate([(0, 0, 0), (5, 0, 0)]):
+        mine = g.object_index == obj
+        if shading == "flat":
+            _check_closed_cube(_subset(g, mine), np.array(center))
+            continue
+        outward = corners(g)[mine] - center
+        scale = np.array([1, 1, 1]) if obj == 0 else np.array([1, 2, 1])
+        expected = outward / scale ** 2            # the inverse transpose of the cube's scale
+        expected /= np.linalg.norm(expected, axis=-1, keepdims=True)
+        np.testing.assert_allclose(n[mine], expected, atol=1e-6)
+
+
+@pytest.mark.parametrize("domain", ["CORNER", "MIXED"])
+def test_normal_rows_give_the_corner_normals_computed_per_corner(scene, fake_session, addon,
+                                                                 monkeypatch, domain):
+    """Corner normals (sharp edges) and vertex normals beside flat faces, on a plain and a
+    mirrored instance: the rows of each mesh's normal table, transformed once each and read
+    through the corners' index, are the bits of normals transformed corner by corner (the
+    layout of meshes with a zero-length normal), in fewer rows."""
+    ob = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)
+    me = ob.data
+    me.shade_smooth()
+    if domain == "CORNER":
+        for edge in me.edges:
+            edge.use_edge_sharp = set(edge.vertices).issubset(me.polygons[0].vertices)
+    else:
+        me.polygons[0].use_smooth = False
+    assert me.normals_domain == "CORNER"       # the export reads vertex and face normals for MIXED
+    twin = ob.copy()
+    twin.location, twin.rotation_euler, twin.scale = (5, 0, 0), (0.3, 0.2, 0.1), (-1, 2, 1)
+    bpy.context.scene.collection.objects.link(twin)
+    table = export_scene(fake_session).geometry
+    mesh_module = importlib.import_module(f"{addon.__name__}.export.mesh")
+    monkeypatch.setattr(mesh_module, "_per_corner_normals", lambda mesh, matrices: True)
+    per_corner = export_scene(fake_session).geometry
+    assert len(per_corner.normals) == 3 * per_corner.num_triangles > len(table.normals)
+    corner = per_corner.corner_normals()
+    assert len({tuple(c) for tri in corner for c in tri}) > 12     # corners of a face differ
+    assert table.corner_normals().tobytes() == corner.tobytes()
+
+
+def _subset(g, mine):
+    """The triangles ``mine`` of a geometry, with their own corner normals (per corner)."""
+    from mcengine.scene import Geometry
+    return Geometry(vertices=g.vertices, triangles=g.triangles[mine],
+                    normals=g.corner_normals()[mine])
 
 
 @pytest.mark.parametrize("shading,domain", [("flat", "FACE"), ("smooth", "POINT"),
@@ -110,7 +177,7 @@ def test_shading_normals_equal_blender_corner_normals(scene, fake_session, shadi
     corner = np.empty(len(me.loops) * 3, np.float32)
     me.corner_normals.foreach_get("vector", corner)
     g = export_scene(fake_session).geometry
-    np.testing.assert_allclose(g.normals.reshape(-1, 3), corner.reshape(-1, 3)[loops], atol=1e-6)
+    np.testing.assert_allclose(g.corner_normals().reshape(-1, 3), corner.reshape(-1, 3)[loops], atol=1e-6)
 
 
 def _blender_triangles(me):
@@ -524,7 +591,7 @@ def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, a
         scene.collection.objects.link(empty)
     cube = new_mesh_object("Cube", CUBE_VERTS, CUBE_FACES)      # no attributes: zeros there
     cube.location, cube.pass_index = (0, 5, 0), 3
-    fields = ("vertices", "triangles", "normals", "uvs", "material_index", "object_index",
+    fields = ("vertices", "triangles", "normals", "normal_index", "uvs", "material_index", "object_index",
               "object_matrix", "object_texspace", "object_info")
     exports = {}
     mesh_module = importlib.import_module(f"{addon.__name__}.export.mesh")
@@ -574,7 +641,7 @@ def test_zero_vertex_normals_become_the_triangles_normal_with_blocks_of_any_size
     normals = {}
     for block in (1 << 20, 5):              # whole instances per block; ranges of triangles
         monkeypatch.setattr(mesh_module, "_BLOCK", block)
-        normals[block] = export_scene(fake_session).geometry.normals
+        normals[block] = export_scene(fake_session).geometry.corner_normals()
     assert normals[5].tobytes() == normals[1 << 20].tobytes()
     np.testing.assert_allclose(np.linalg.norm(normals[5], axis=-1), 1.0, rtol=1e-6)
     line = normals[5][-1]                   # the collinear triangle, last

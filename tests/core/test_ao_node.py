@@ -37,11 +37,10 @@ def _scene():
     verts = np.array([(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0),
                       (WALL, -50, -50), (WALL, 50, -50), (WALL, 50, 50), (WALL, -50, 50)], float)
     tris = np.array([(0, 1, 2), (0, 2, 3), (4, 7, 6), (4, 6, 5)], np.int32)
-    normals = np.zeros((4, 3, 3), np.float32)
-    normals[:2, :, 2] = 1.0
-    normals[2:, :, 0] = -1.0
+    normals = np.array([(0, 0, 1), (-1, 0, 0)], np.float32)      # the floor's and the wall's
+    index = np.repeat(np.array([0, 0, 1, 1], np.int32)[:, None], 3, axis=1)
     tri_object = np.array([0, 0, 1, 1], np.int32)
-    tex = NO_TEXTURES._replace(normals=normals, tri_object=tri_object,
+    tex = NO_TEXTURES._replace(normals=normals, normal_index=index, tri_object=tri_object,
                                objects=np.zeros((2, OBJ_STRIDE)))
     local = build_local_bvh(verts, tris, tri_object, 2, [0], scene_ids=np.arange(4, dtype=np.int32))
     return verts, tris, tex, local

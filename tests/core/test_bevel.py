@@ -29,9 +29,11 @@ def _box():
     e2 = _CORNERS[tris[:, 2]] - _CORNERS[tris[:, 0]]
     n = np.cross(e1, e2)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
-    normals = np.ascontiguousarray(np.repeat(n[:, None, :], 3, axis=1), np.float32)
+    normals = np.ascontiguousarray(n, np.float32)                  # a face normal per triangle
+    index = np.repeat(np.arange(len(tris), dtype=np.int32)[:, None], 3, axis=1)
     tri_object = np.zeros(len(tris), np.int32)
-    return _CORNERS.copy(), tris, NO_TEXTURES._replace(normals=normals, tri_object=tri_object)
+    return _CORNERS.copy(), tris, NO_TEXTURES._replace(normals=normals, normal_index=index,
+                                                       tri_object=tri_object)
 
 
 @pytest.fixture(scope="module", params=[True, False], ids=["embree", "hierarchy"])

@@ -80,7 +80,7 @@ def test_a_scene_without_true_displacement_is_left_as_it_is():
 def test_a_constant_height_lifts_every_vertex_along_its_normal():
     out = displace(_scene(_displaced_by(_constant(0.25)))).geometry
     np.testing.assert_allclose(out.vertices, SQUARE + [0.0, 0.0, 0.25], atol=1e-7)
-    np.testing.assert_allclose(out.normals[..., 2], 1.0, atol=1e-7)
+    np.testing.assert_allclose(out.corner_normals()[..., 2], 1.0, atol=1e-7)
     # What the Generated output and the bump of 'Displacement and Bump' read there: the
     # points before displacement, flagged as on a displaced mesh, and the normals.
     undisplaced = out.attributes[UNDISPLACED_ATTRIBUTE]
@@ -114,8 +114,8 @@ def test_the_vertex_normal_gives_the_direction_on_flat_faces_too():
     np.testing.assert_allclose(out.vertices, expected, atol=1e-7)
     p = expected[TRIS[0]]
     face = np.cross(p[1] - p[0], p[2] - p[0])
-    np.testing.assert_allclose(out.normals[0], np.tile(face / np.linalg.norm(face), (3, 1)), atol=1e-6)
-    np.testing.assert_allclose(out.normals[1], np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-6)
+    np.testing.assert_allclose(out.corner_normals()[0], np.tile(face / np.linalg.norm(face), (3, 1)), atol=1e-6)
+    np.testing.assert_allclose(out.corner_normals()[1], np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-6)
 
 
 @pytest.mark.parametrize("method", ["DISPLACEMENT", "BOTH"])
@@ -126,7 +126,7 @@ def test_normals_follow_a_tilt_unless_the_bump_does(method):
     out = displace(_scene(_displaced_by(_coordinate("Generated"), method))).geometry
     np.testing.assert_allclose(out.vertices[:, 2], SQUARE[:, 0], atol=1e-6)
     expected = [-np.sqrt(0.5), 0.0, np.sqrt(0.5)] if method == "DISPLACEMENT" else [0.0, 0.0, 1.0]
-    np.testing.assert_allclose(out.normals.reshape(-1, 3), np.tile(expected, (6, 1)), atol=1e-6)
+    np.testing.assert_allclose(out.corner_normals().reshape(-1, 3), np.tile(expected, (6, 1)), atol=1e-6)
 
 
 def test_motion_steps_move_with_the_frame():

@@ -215,7 +215,7 @@ def moving_scene():
     soft_rest = verts[18:36]
     spread = np.array([-0.3, 0.0, 0.5])[:, None, None]       # shrinks, then spreads out
     soft_steps = soft_rest[None] + spread * (soft_rest - soft_rest.mean(axis=0))[None]
-    normals = np.broadcast_to(g.normals[6:12], (3, 6, 3, 3)).astype(np.float32)
+    normals = np.broadcast_to(g.corner_normals()[6:12], (3, 6, 3, 3)).astype(np.float32)
     motions = [ObjectMotion(object=0, vertices=(0, 18), matrices=mats),
                ObjectMotion(object=1, vertices=(18, 18), positions=soft_steps.astype(np.float32),
                             normals=normals)]

@@ -68,6 +68,43 @@ def test_saved_scene_keeps_each_objects_terminator_offsets(tmp_path):
     np.testing.assert_array_equal(loaded.geometry.terminator_offsets(), [[0.4, 0.7]])
 
 
+def test_saved_scene_keeps_its_normal_table_and_reads_files_with_normals_per_corner(tmp_path):
+    """A table of normals and each corner's row survive saving; a file of the former layout,
+    a normal per corner and no index, loads to the same corner normals."""
+    scene = _scene()
+    g = scene.geometry
+    corner = g.corner_normals()
+    t = g.num_triangles
+    g.normals = np.concatenate([np.zeros((1, 3), np.float32), np.unique(corner.reshape(-1, 3), axis=0)])
+    g.normal_index = np.array([[np.flatnonzero((g.normals == c).all(axis=1))[0] for c in tri]
+                               for tri in corner], np.int32)
+    assert len(g.normals) < 3 * t
+    np.testing.assert_array_equal(g.corner_normals(), corner)
+    scene.save(tmp_path / "table.npz")
+    loaded = SceneDescription.load(tmp_path / "table.npz").geometry
+    np.testing.assert_array_equal(loaded.normals, g.normals)
+    np.testing.assert_array_equal(loaded.normal_index, g.normal_index)
+    data = (tmp_path / "table.npz").read_bytes()
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as src, zipfile.ZipFile(out, "w") as dst:
+        for info in src.infolist():
+            if info.filename == "normals.npy":
+                dst.writestr(info.filename, _npy(corner))
+            elif info.filename != "normal_index.npy":
+                dst.writestr(info.filename, src.read(info))
+    old = _load(tmp_path, out.getvalue()).geometry
+    assert old.normals.shape == (3 * t, 3)
+    np.testing.assert_array_equal(old.corner_normals(), corner)
+
+
+@pytest.mark.parametrize("index", [-1, 10 ** 6])
+def test_validation_refuses_corners_whose_normal_row_does_not_exist(index):
+    scene = _scene()
+    scene.geometry.normal_index[0, 1] = index
+    with pytest.raises(SceneError, match="normal_index"):
+        scene.validate()
+
+
 def _saved(tmp_path, scene=None) -> bytes:
     path = tmp_path / "scene.npz"
     (scene or inside_sphere_scene(samples=1, res=4)).save(path)

@@ -69,7 +69,7 @@ def test_a_deforming_plane():
     scene.motion_vectors = MotionVectors(objects=[ObjectMotion(
         object=0, vertices=(0, len(g.vertices)),
         positions=np.stack([0.5 * g.vertices, g.vertices, 1.5 * g.vertices]).astype(np.float32),
-        normals=np.stack([g.normals] * 3).astype(np.float32))])
+        normals=np.stack([g.corner_normals()] * 3).astype(np.float32))])
     r = (np.arange(8) + 0.5 - 4.0) * 0.25 * 4
     v = _vectors(scene, samples=64)
     np.testing.assert_allclose(v[..., 0], np.broadcast_to(-0.5 * r, (8, 8)), atol=0.03)

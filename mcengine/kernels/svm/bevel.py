@@ -89,7 +89,7 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
     if (radius <= 0.0 or samples < 1 or obj < 0 or sd.prim < 0 or sd.min_pdf < MIN_RAY_PDF
             or obj >= local.root.shape[0]):
         return sd.nx, sd.ny, sd.nz
-    normals = tex.normals
+    normals, normal_index = tex.normals, tex.normal_index
     sx = sy = sz = 0.0
     for s in range(samples):
         u1, u2 = branched_2d(sd.rng, s)
@@ -113,7 +113,7 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
             t, b1, b2 = intersect_prim(ox, oy, oz, -nx, -ny, -nz, verts, tris, p)
             if not math.isfinite(t):
                 continue
-            gx, gy, gz = _geometric_normal(verts, tris, normals, p)
+            gx, gy, gz = _geometric_normal(verts, tris, normals, normal_index, p)
             pdf_n = pick_n * abs(nx * gx + ny * gy + nz * gz)
             pdf_t = pick_t * abs(tx * gx + ty * gy + tz * gz)
             pdf_b = pick_b * abs(bx * gx + by * gy + bz * gz)
@@ -123,7 +123,7 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
             hx, hy, hz = ox - t * nx - sd.px, oy - t * ny - sd.py, oz - t * nz - sd.pz
             w = pdf_n / den * scale * _cubic_pdf(radius, math.sqrt(hx * hx + hy * hy + hz * hz)) \
                 / disk_pdf
-            mx, my, mz = _smooth_normal(normals, p, b1, b2, gx, gy, gz)
+            mx, my, mz = _smooth_normal(normals, normal_index, p, b1, b2, gx, gy, gz)
             sx += w * mx
             sy += w * my
             sz += w * mz
@@ -136,7 +136,7 @@ def bevel_normal(radius, samples, sd, tex, verts, tris, local):
 
 
 @device
-def _geometric_normal(verts, tris, normals, p):
+def _geometric_normal(verts, tris, normals, normal_index, p):
     """Unit normal of triangle p's plane on the object's outside (0 if degenerate)."""
     a, b, c = tris[p, 0], tris[p, 1], tris[p, 2]
     e1x, e1y, e1z = verts[b, 0] - verts[a, 0], verts[b, 1] - verts[a, 1], verts[b, 2] - verts[a, 2]
@@ -145,17 +145,18 @@ def _geometric_normal(verts, tris, normals, p):
     length = math.sqrt(gx * gx + gy * gy + gz * gz)
     if not length > 0.0:
         return 0.0, 0.0, 0.0
-    return facing_corners(normals, p, gx / length, gy / length, gz / length)
+    return facing_corners(normals, normal_index, p, gx / length, gy / length, gz / length)
 
 
 @device
-def _smooth_normal(normals, p, b1, b2, gx, gy, gz):
+def _smooth_normal(normals, normal_index, p, b1, b2, gx, gy, gz):
     """The corner normals of triangle p interpolated at barycentrics (b1, b2) and
     normalised; the geometric normal g where they cancel (Cycles' triangle_smooth_normal)."""
     b0 = 1.0 - b1 - b2
-    x = b0 * normals[p, 0, 0] + b1 * normals[p, 1, 0] + b2 * normals[p, 2, 0]
-    y = b0 * normals[p, 0, 1] + b1 * normals[p, 1, 1] + b2 * normals[p, 2, 1]
-    z = b0 * normals[p, 0, 2] + b1 * normals[p, 1, 2] + b2 * normals[p, 2, 2]
+    i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
+    x = b0 * normals[i0, 0] + b1 * normals[i1, 0] + b2 * normals[i2, 0]
+    y = b0 * normals[i0, 1] + b1 * normals[i1, 1] + b2 * normals[i2, 1]
+    z = b0 * normals[i0, 2] + b1 * normals[i1, 2] + b2 * normals[i2, 2]
     length = math.sqrt(x * x + y * y + z * z)
     if not length > 0.0:
         return gx, gy, gz

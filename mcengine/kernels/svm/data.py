@@ -36,7 +36,8 @@ ShadingData = namedtuple("ShadingData", [
 
 TextureData = namedtuple("TextureData", [
     "attr",                    # (T, 3, S) f32  per-corner attributes (``ATTR_*`` layout, shaders.py)
-    "normals",                 # (T, 3, 3) f32  world shading normals at the corners (SceneData.normals)
+    "normals",                 # (K, 3) f32     world shading normals (Geometry.normals)
+    "normal_index",            # (T, 3) int32   the row of ``normals`` of each triangle corner
     "tri_object",              # (T,) int32     object of each triangle
     "objects",                 # (O, OBJ_STRIDE) f64  per-object data (OBJ_* columns)
     "camera",                  # (CAMERA_PARAMS,) f64  the camera (Camera and Window coordinates)

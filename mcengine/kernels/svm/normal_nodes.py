@@ -76,8 +76,9 @@ def normal_map(regs, b, sd, tex):
         nx = ny = nz = 0.0
         for k in range(3):
             w = b0 if k == 0 else (b1 if k == 1 else b2)
-            x, y, z = normal_to_object(o, float(tex.normals[p, k, 0]), float(tex.normals[p, k, 1]),
-                                       float(tex.normals[p, k, 2]))
+            row = tex.normal_index[p, k]
+            x, y, z = normal_to_object(o, float(tex.normals[row, 0]), float(tex.normals[row, 1]),
+                                       float(tex.normals[row, 2]))
             nx += w * x
             ny += w * y
             nz += w * z

@@ -322,18 +322,25 @@ def pack_attributes(g) -> tuple[AttributeLayout, np.ndarray]:
     """The per-corner attributes as one (T, 3, S) float32 array: the default UV map first
     (``svm.ATTR_DEFAULT_UV``), then every named attribute; and where each one lives.
 
-    Without named attributes the array is the geometry's own UVs, not a copy (22 bytes
-    per triangle: 88 MiB at 4M triangles)."""
+    A named attribute equal to the default UV map everywhere (the UV map of meshes whose
+    only or active render map it is; the export gives it as the same array) is read from
+    the default's columns rather than packed again.  Without other named attributes the
+    array is the geometry's own UVs, not a copy (24 bytes per triangle: 92 MiB at 4M
+    triangles)."""
     layout = AttributeLayout()
-    columns = [np.asarray(g.uvs, np.float32).reshape(-1, 3, 2)]
-    if not g.attributes:
-        return layout, np.ascontiguousarray(columns[0])
+    uvs = np.asarray(g.uvs, np.float32).reshape(-1, 3, 2)
+    columns = [uvs]
     offset = 2
     for name, a in g.attributes.items():
+        if a is g.uvs or (np.shape(a) == uvs.shape and np.array_equal(a, uvs)):
+            layout.offsets[name] = (0, 2)
+            continue
         a = np.asarray(a, np.float32)
         layout.offsets[name] = (offset, a.shape[2])
         columns.append(a)
         offset += a.shape[2]
+    if len(columns) == 1:
+        return layout, np.ascontiguousarray(uvs)
     return layout, np.ascontiguousarray(np.concatenate(columns, axis=2))
 
 

@@ -440,15 +440,22 @@ def _place_all(parts, unit_scale: float) -> Geometry:
     shared = not any(per_corner) and all(mesh.normals.index is mesh.triangles
                                          for mesh, _m, _n, _i in parts)
     # Zeros only where values may be missing (untouched zero pages cost no memory).
+    uvs = np.zeros((t_all, 3, 2), np.float32)
+    # A UV map that is every mesh's default where any mesh has it is the default UVs
+    # themselves: one array, not two equal ones (24 bytes per triangle).
+    same_as_uvs = {name for name, c in sizes.items() if c == 2 and all(
+        mesh.uv_name == name or (mesh.uv_name is None and name not in mesh.attributes)
+        for mesh, _m, _n, _i in parts)}
     out = Geometry(vertices=np.empty((v_all, 3), np.float32),
                    triangles=triangles,
                    normals=np.empty((k_all, 3), np.float32),
                    normal_index=triangles if shared else np.empty((t_all, 3), np.int32),
-                   uvs=np.zeros((t_all, 3, 2), np.float32),
+                   uvs=uvs,
                    material_index=np.empty(t_all, np.int32),
                    object_index=np.empty(t_all, np.int32),
                    object_names=[name for _mesh, _m, names, _i in parts for name in names],
-                   attributes={name: np.zeros((t_all, 3, c), np.float32) for name, c in sizes.items()},
+                   attributes={name: uvs if name in same_as_uvs else np.zeros((t_all, 3, c), np.float32)
+                               for name, c in sizes.items()},
                    object_matrix=np.empty((o_all, 4, 4)), object_texspace=np.empty((o_all, 2, 3)),
                    object_info=np.zeros((o_all, 6)))
     t0 = v0 = n0 = o0 = 0
@@ -573,7 +580,7 @@ def _transform_block(mesh, out, pos, cof, flip, i0, a0, a1, t0, v0, n0, rows_per
             corners[flip] = corners[flip][:, :, _FLIP]
         corners = corners.reshape(-1, 3, values.table.shape[1])
         out.attributes[name][rows, :, :values.table.shape[1]] = corners
-        if name == mesh.uv_name:
+        if name == mesh.uv_name and out.attributes[name] is not out.uvs:
             out.uvs[rows] = corners
     tris = tris.reshape(-1, 3)
     out.triangles[rows] = tris + v0

@@ -258,6 +258,28 @@ def test_meshes_with_ngons_get_blenders_triangles(scene, fake_session):
     np.testing.assert_array_equal(expected[1], [[0, 1, 3], [1, 2, 3]])   # concave: cut along 1-3
 
 
+def test_a_uv_map_every_mesh_renders_with_is_the_default_uvs_array(scene, fake_session):
+    """Two meshes whose active render UV map is "UVMap" (and one with no UV map): the
+    attribute "UVMap" is the geometry's default UVs, one array; a second map stays its own,
+    as does "UVMap" once a mesh renders with another map."""
+    a = new_mesh_object("A", TRI, [(0, 1, 2)])
+    b = new_mesh_object("B", TRI, [(0, 1, 2)])
+    b.location = (0, 3, 0)
+    new_mesh_object("Bare", TRI, [(0, 1, 2)]).location = (0, 6, 0)
+    for ob, value in ((a, 0.25), (b, 0.75)):
+        ob.data.uv_layers.new(name="UVMap").uv.foreach_set("vector", [value] * 6)
+    a.data.uv_layers.new(name="Second").uv.foreach_set("vector", [0.5] * 6)
+    g = export_scene(fake_session).geometry
+    assert g.attributes["UVMap"] is g.uvs and g.attributes["Second"] is not g.uvs
+    np.testing.assert_array_equal(g.uvs[:, 0, 0], [0.25, 0.75, 0.0])
+    np.testing.assert_array_equal(g.attributes["Second"][:, 0, 0], [0.5, 0.0, 0.0])
+    a.data.uv_layers["Second"].active_render = True
+    g = export_scene(fake_session).geometry
+    assert g.attributes["UVMap"] is not g.uvs
+    np.testing.assert_array_equal(g.uvs[:, 0, 0], [0.5, 0.75, 0.0])
+    np.testing.assert_array_equal(g.attributes["UVMap"][:, 0, 0], [0.25, 0.75, 0.0])
+
+
 def test_uvs_come_from_the_active_render_uv_map(scene, fake_session):
     ob = new_mesh_object("Tri", TRI, [(0, 1, 2)])
     first, second = ob.data.uv_layers.new(name="First"), ob.data.uv_layers.new(name="Second")

@@ -90,7 +90,7 @@ def test_accounting_names_dropped_non_finite_samples_only_when_there_are_some():
 
 def test_the_default_uv_map_is_packed_without_a_copy():
     """The shaders' attribute array is the geometry's own UVs when there is nothing else to
-    pack (a copy costs 88 MiB at 4M triangles); with a named attribute it holds both."""
+    pack (a copy costs 92 MiB at 4M triangles); with a named attribute it holds both."""
     from mcengine.packing import pack_attributes
     from mcengine.scene import Geometry
 
@@ -104,3 +104,14 @@ def test_the_default_uv_map_is_packed_without_a_copy():
     layout, attr = pack_attributes(geo)
     assert attr.shape == (geo.num_triangles, 3, 6) and layout.offsets == {"": (0, 2), "Col": (2, 4)}
     np.testing.assert_array_equal(attr[:, :, :2], geo.uvs)
+    # A named UV map equal to the default UVs (the same array, or equal values as a loaded
+    # file gives them) is read from the default's columns; one that differs is packed.
+    other = geo.uvs.copy()
+    other[0, 0, 0] += 1.0
+    geo.attributes = {"UVMap": geo.uvs, "Copy": geo.uvs.copy(), "Other": other}
+    layout, attr = pack_attributes(geo)
+    assert layout.offsets == {"": (0, 2), "UVMap": (0, 2), "Copy": (0, 2), "Other": (2, 2)}
+    np.testing.assert_array_equal(attr[:, :, 2:4], other)
+    geo.attributes = {"UVMap": geo.uvs}
+    layout, attr = pack_attributes(geo)
+    assert np.shares_memory(attr, geo.uvs) and layout.offsets == {"": (0, 2), "UVMap": (0, 2)}

@@ -514,10 +514,7 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
     rows = 3 * t if per_corner else len(mesh.normals.table)      # normal rows per instance
     if not per_corner:
         _normal_rows(mesh.normals.table, cof, out.normals[n0:n0 + n * rows])
-    per_block = max(1, _BLOCK // max(t, 1))          # whole instances per block
-    step = max(t, 1) if per_block > 1 else _BLOCK   # or triangles of one instance per block
-    blocks = [(i0, min(n, i0 + per_block), a0) for i0 in range(0, n, per_block)
-              for a0 in range(0, t, step)]
+    step, blocks = _blocks(n, t)
     # The blocks write disjoint rows of ``out``: on threads (numpy releases the GIL).
     map_threads(lambda b: _transform_block(mesh, out, pos, cof[b[0]:b[1]], flip[b[0]:b[1]], b[0],
                                            b[2], min(t, b[2] + step), t0, v0, n0, rows,
@@ -525,15 +522,22 @@ def _place_instances(mesh: LocalMesh, matrices, unit_scale: float, out: Geometry
     return n0 + n * rows
 
 
+def _blocks(n: int, rows: int) -> tuple[int, list]:
+    """About ``_BLOCK`` rows at a time of N instances of ``rows`` rows each: several whole
+    instances per block, or ranges of one instance's rows.  Returns (step, blocks): each
+    block (i0, i1, r0) is instances i0..i1-1 from row r0, ``step`` rows (fewer at the end)."""
+    per_block = max(1, _BLOCK // max(rows, 1))       # whole instances per block
+    step = max(rows, 1) if per_block > 1 else _BLOCK
+    return step, [(i0, min(n, i0 + per_block), r0) for i0 in range(0, n, per_block)
+                  for r0 in range(0, rows, step)]
+
+
 def _normal_rows(table, cof, out):
     """``out`` (N K, 3) float32: the rows of a mesh's normal table (K, 3) transformed by each of
     N instances' ``cof`` and normalised, as :func:`_unit_normals` computes them for a corner
     (no row has zero length: ``_per_corner_normals``); in blocks on threads."""
     k_rows = len(table)
-    per_block = max(1, _BLOCK // max(k_rows, 1))     # whole instances per block
-    step = max(k_rows, 1) if per_block > 1 else _BLOCK
-    blocks = [(i0, min(len(cof), i0 + per_block), r0) for i0 in range(0, len(cof), per_block)
-              for r0 in range(0, k_rows, step)]
+    step, blocks = _blocks(len(cof), k_rows)
 
     def block(b):
         i0, i1, r0 = b

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..jit import device, kernel
 from . import embree
-from .motion import moving_closest, moving_normals, moving_occluded, moving_triangle
+from .motion import corner_normals, moving_closest, moving_normals, moving_occluded, moving_triangle
 from .scalar import saturate
 from .state import (
     PF_CAMERA,
@@ -281,9 +281,7 @@ def prim_normals(sc, p, time):
     if is_moving(sc, p):
         return moving_normals(sc.motion, sc.verts, sc.tris, sc.tex.normals, sc.tex.normal_index,
                               p, time)
-    n, ni = sc.tex.normals, sc.tex.normal_index
-    a, b, c = ni[p, 0], ni[p, 1], ni[p, 2]
-    return n[a, 0], n[a, 1], n[a, 2], n[b, 0], n[b, 1], n[b, 2], n[c, 0], n[c, 1], n[c, 2]
+    return corner_normals(sc.tex.normals, sc.tex.normal_index, p)
 
 
 @device

@@ -311,8 +311,7 @@ def pack_motion(geometry, objects) -> MotionData:
     tris = np.asarray(geometry.triangles, np.int64)
     tri_slot = np.full(t, -1, np.int32)
     tri_local = np.full(t, -1, np.int32)
-    n = geometry.corner_normals()
-    tri_flat = (np.all(n[:, 0] == n[:, 1], axis=1) & np.all(n[:, 0] == n[:, 2], axis=1)).astype(np.uint8)
+    tri_flat = np.zeros(t, np.uint8)        # read for moving triangles only: set below
     info = np.zeros((len(objects), SLOT_INFO), np.int64)
     xforms, positions, normals, roots = [], [], [], []
     frame = np.zeros((len(objects), 12))
@@ -324,6 +323,8 @@ def pack_motion(geometry, objects) -> MotionData:
         mine = np.flatnonzero(geometry.object_index == om.object).astype(np.int32)
         tri_slot[mine] = j
         tri_local[mine] = np.arange(len(mine), dtype=np.int32)
+        n = np.take(geometry.normals, geometry.normal_index[mine], axis=0)
+        tri_flat[mine] = np.all(n[:, 0] == n[:, 1], axis=1) & np.all(n[:, 0] == n[:, 2], axis=1)
         first, count = (int(v) for v in om.vertices)
         steps = om.steps
         info[j, SI_STEPS], info[j, SI_VFIRST], info[j, SI_VCOUNT] = steps, first, count
@@ -563,6 +564,15 @@ def moving_triangle(md, verts, tris, p, time):
     return ax, ay, az, bx, by, bz, cx, cy, cz
 
 
+@device
+def corner_normals(normals, normal_index, p):
+    """The shading normals of triangle p's three corners (9 floats): the rows
+    ``normal_index[p, k]`` of the normal table (``Geometry.normals``)."""
+    i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
+    return (normals[i0, 0], normals[i0, 1], normals[i0, 2], normals[i1, 0], normals[i1, 1],
+            normals[i1, 2], normals[i2, 0], normals[i2, 1], normals[i2, 2])
+
+
 @function
 def moving_normals(md, verts, tris, normals, normal_index, p, time):
     """The corner shading normals of moving triangle p in world space at ``time`` (9 floats,
@@ -579,10 +589,7 @@ def moving_normals(md, verts, tris, normals, normal_index, p, time):
         nx, ny, nz = _unit(e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x)
         return nx, ny, nz, nx, ny, nz, nx, ny, nz
     if info[j, SI_NRM] < 0:
-        i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
-        n0x, n0y, n0z = normals[i0, 0], normals[i0, 1], normals[i0, 2]
-        n1x, n1y, n1z = normals[i1, 0], normals[i1, 1], normals[i1, 2]
-        n2x, n2y, n2z = normals[i2, 0], normals[i2, 1], normals[i2, 2]
+        n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z = corner_normals(normals, normal_index, p)
     else:
         step, f = motion_step(info[j, SI_STEPS], time)
         a = info[j, SI_NRM] + step * info[j, SI_NTRIS] + md.tri_local[p]

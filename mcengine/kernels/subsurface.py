@@ -41,7 +41,7 @@ from . import embree
 from .closures.bssrdf import disk_sample, disk_weight
 from .embree import intersect_one
 from .intersect import triangle_frame
-from .motion import BVH_LEAF, build_bvh, hit_triangle, ray_box
+from .motion import BVH_LEAF, build_bvh, corner_normals, hit_triangle, ray_box
 from .sampling import make_orthonormals, orthonormal_basis, rand, sample_2d, sample_4d
 
 MAX_STEPS = 256                  # Cycles' BSSRDF_MAX_BOUNCES
@@ -443,10 +443,10 @@ def hit_normal(normals, normal_index, verts, tris, p, flip):
 def facing_corners(normals, normal_index, p, gx, gy, gz):
     """The normal g of triangle p, on the side its corner normals say (the object's outside:
     a mirrored object's winding is reversed); ``normals[normal_index[p, k]]`` is corner k's."""
-    i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
-    sx = normals[i0, 0] + normals[i1, 0] + normals[i2, 0]
-    sy = normals[i0, 1] + normals[i1, 1] + normals[i2, 1]
-    sz = normals[i0, 2] + normals[i1, 2] + normals[i2, 2]
+    n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z = corner_normals(normals, normal_index, p)
+    sx = n0x + n1x + n2x
+    sy = n0y + n1y + n2y
+    sz = n0z + n1z + n2z
     if sx * gx + sy * gy + sz * gz < 0.0:
         return -gx, -gy, -gz
     return gx, gy, gz

@@ -27,6 +27,7 @@ import math
 
 from ...jit import device, function
 from ..intersect import intersect_prim
+from ..motion import corner_normals
 from ..sampling import branched_2d, node_key
 from ..subsurface import DISK_MAX_HITS, disk_axes, facing_corners, probe
 from .nodes import OFFSETS
@@ -153,10 +154,10 @@ def _smooth_normal(normals, normal_index, p, b1, b2, gx, gy, gz):
     """The corner normals of triangle p interpolated at barycentrics (b1, b2) and
     normalised; the geometric normal g where they cancel (Cycles' triangle_smooth_normal)."""
     b0 = 1.0 - b1 - b2
-    i0, i1, i2 = normal_index[p, 0], normal_index[p, 1], normal_index[p, 2]
-    x = b0 * normals[i0, 0] + b1 * normals[i1, 0] + b2 * normals[i2, 0]
-    y = b0 * normals[i0, 1] + b1 * normals[i1, 1] + b2 * normals[i2, 1]
-    z = b0 * normals[i0, 2] + b1 * normals[i1, 2] + b2 * normals[i2, 2]
+    n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z = corner_normals(normals, normal_index, p)
+    x = b0 * n0x + b1 * n1x + b2 * n2x
+    y = b0 * n0y + b1 * n1y + b2 * n2y
+    z = b0 * n0z + b1 * n1z + b2 * n2z
     length = math.sqrt(x * x + y * y + z * z)
     if not length > 0.0:
         return gx, gy, gz

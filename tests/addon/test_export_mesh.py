@@ -646,10 +646,11 @@ def test_blocks_of_the_transform_do_not_change_the_export(scene, fake_session, a
 
 def test_zero_vertex_normals_become_the_triangles_normal_with_blocks_of_any_size(
         scene, fake_session, addon, monkeypatch):
-    """Normals are transformed once per corner (whole instances in a block) or once per
-    row of the mesh's normal table (a large mesh in ranges of triangles); both give the
-    same bytes, and a vertex Blender gives no normal (on a triangle whose corners lie on a
-    line) takes its triangle's geometric normal there, +z when it has none either."""
+    """A vertex Blender gives no normal (on a triangle whose corners lie on a line) makes its
+    mesh keep a normal per corner, and such a corner takes its triangle's geometric normal,
+    +z when it has none either; whole instances per block and ranges of triangles give the
+    same bytes.  (``test_normal_rows_give_the_corner_normals_computed_per_corner`` checks
+    the table layout against this per-corner one.)"""
     n = 4
     verts = [(x, y, 0.1 * ((x + 2 * y) % 3)) for y in range(n + 1) for x in range(n + 1)]
     quads = [(y * (n + 1) + x, y * (n + 1) + x + 1, (y + 1) * (n + 1) + x + 1, (y + 1) * (n + 1) + x)
@@ -666,6 +667,7 @@ def test_zero_vertex_normals_become_the_triangles_normal_with_blocks_of_any_size
         normals[block] = export_scene(fake_session).geometry.corner_normals()
     assert normals[5].tobytes() == normals[1 << 20].tobytes()
     np.testing.assert_allclose(np.linalg.norm(normals[5], axis=-1), 1.0, rtol=1e-6)
+    assert len(export_scene(fake_session).geometry.normals) == 3 * len(normals[5])
     line = normals[5][-1]                   # the collinear triangle, last
     assert any(np.array_equal(c, [0.0, 0.0, 1.0]) for c in line)
 

@@ -158,3 +158,18 @@ def test_images_and_world_graph_survive_save_and_load(tmp_path):
 def test_bad_images_are_refused(image, message):
     with pytest.raises(SceneError, match=message):
         SceneDescription(images={"bad": image}).validate()
+
+
+def test_srgb_decoding_follows_the_curve_it_tabulates():
+    """The kernels decode 8-bit sRGB texels through a table of the curve's power segment: at
+    most 2.3e-8 from the exact curve, 2.8e-6 of it relatively (the segment's dark end);
+    above 1 (a colour divided by alpha), below 0 and NaN as the formula gives them."""
+    from mcengine.kernels.svm.image_nodes import srgb_to_linear
+    c = np.concatenate([np.linspace(-0.1, 1.3, 140_001), [0.04045, np.nextafter(1.0, 0.0), 1.0],
+                        np.nextafter(0.04045, 1.0) + np.arange(1, 4097) / 4096])
+    exact = np.where(c < 0.04045, np.maximum(c, 0.0) / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    ours = np.array([srgb_to_linear(x) for x in c])
+    assert np.abs(ours - exact).max() <= 2.3e-8
+    assert (np.abs(ours - exact) / np.maximum(exact, 1e-300)).max() <= 2.8e-6
+    assert srgb_to_linear(1.0) == 1.0 and srgb_to_linear(-0.5) == 0.0
+    assert np.isnan(srgb_to_linear(np.nan))

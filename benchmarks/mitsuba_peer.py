@@ -134,13 +134,15 @@ def scene_spec(desc, folder: Path) -> tuple[dict, list]:
                          "radiance": {"type": "rgb", "value": [float(c) for c in desc.world.color]}}
     principled = False
     g = desc.geometry
+    corner_normals = g.corner_normals()
     for k, material in enumerate(desc.materials):
         mask = g.material_index == k
         if not mask.any():
             continue
         bsdf = _bsdf(material)
         principled |= bsdf["type"] == "principled"
-        flat = _write_ply(folder / f"mesh_{k}.ply", g.vertices, g.triangles[mask], g.normals[mask])
+        flat = _write_ply(folder / f"mesh_{k}.ply", g.vertices, g.triangles[mask],
+                           corner_normals[mask])
         spec[f"mesh_{k}"] = {"type": "ply", "filename": str(folder / f"mesh_{k}.ply"),
                              "face_normals": flat, "bsdf": bsdf}
     for k, li in enumerate(desc.lights):

@@ -12,7 +12,7 @@ It renders a few samples of one pixel of a tiny scene with each integrator
 (every shader node and closure is compiled with the shader evaluator, whatever
 the scene uses), and one of a scene with what else a render may compile
 (``features_scene``: motion blur, a world and a mesh light whose radiance varies, true
-displacement),
+displacement; and the export's MikkTSpace tangents),
 then marks the cache ready (``jit.cache_is_ready``).  numba compiles on one core, so a
 second process (``python -m mcengine.warmup --steps STEP...``) shares the work: while this
 one compiles the procedural textures' node function, it compiles the evaluator's other node
@@ -164,7 +164,17 @@ def _compile(steps) -> None:
         else:
             scene = features_scene() if step == FEATURES else warm_up_scene(step)
             RenderSession(scene, threads=1).run()
+            if step == FEATURES:
+                _compile_tangents()
         _marker(step).touch()
+
+
+def _compile_tangents() -> None:
+    """The MikkTSpace tangents the export computes for normal maps (``kernels.tangents``), on
+    one triangle."""
+    from .kernels.tangents import mikktspace
+    corners = np.eye(3, dtype=np.float32)
+    mikktspace(corners, [(0, 1, 2)], np.ones((3, 3), np.float32), corners[:, :2])
 
 
 def _node_functions(step: str) -> list:

@@ -38,6 +38,7 @@ from mcengine.kernels.state import (
     VIS_TRANSMISSION,
 )
 from mcengine.kernels.svm.nodes import TANGENT_PREFIX
+from mcengine.kernels.tangents import mikktspace
 from mcengine.mesh_attributes import pointiness, random_per_island, sphere_uv
 from mcengine.parallel import map_threads, take
 from mcengine.scene import Geometry, ObjectPassInfo, auto_texspace_size
@@ -805,12 +806,15 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
 
     Cycles runs MikkTSpace on the triangles (``loop_triangles``), with the mesh's shading
     normals (flat faces: each triangle's own normal), so the tangents are those Blender's
-    ``Mesh.calc_tangents`` computes for a mesh of those triangles; on a mesh of quads it
-    would pair the triangles differently.  The default map of a mesh without UV maps is, as
-    in Cycles (blender/mesh.cpp, mikk_compute_tangents), the generated coordinates mapped to
-    a sphere: ``sphere_uv`` of each vertex's object-space position.  A named map the mesh
-    lacks is left out, as in Cycles (the normal stays unchanged).  Returns what went wrong,
-    for a note: "" or ``SPHERE_SEAM``, a mesh the sphere mapping's seam crosses."""
+    MikkTSpace computes for a mesh of those triangles (``kernels.tangents``: the same bits as
+    ``Mesh.calc_tangents`` on such a mesh, but computed in one order, where Blender's
+    threads make them vary in the last bit on meshes of more than 10,000 faces); on a mesh of
+    quads it would pair the triangles differently.  The default map of a mesh without UV
+    maps is, as in Cycles (blender/mesh.cpp, mikk_compute_tangents), the generated
+    coordinates mapped to a sphere: ``sphere_uv`` of each vertex's object-space position.  A
+    named map the mesh lacks is left out, as in Cycles (the normal stays unchanged).  Returns
+    what went wrong, for a note: "" or ``SPHERE_SEAM``, a mesh the sphere mapping's seam
+    crosses."""
     layers = {}
     for name in maps:
         layer = default_layer if name == "" else me.uv_layers.get(name)
@@ -826,31 +830,10 @@ def _add_tangents(me, vertices, triangles, normals, maps, default_layer, attribu
         if np.any(u.max(axis=1) - u.min(axis=1) > 0.5):     # a triangle spans the seam
             note = SPHERE_SEAM
     t = len(triangles)
-    corner_normals = normals.corners(0, t).reshape(-1, 3)
-    tm = bpy.data.meshes.new(".mcengine tangents")
-    try:
-        tm.vertices.add(len(vertices))
-        tm.vertices.foreach_set("co", np.ascontiguousarray(vertices, np.float32).ravel())
-        tm.loops.add(3 * t)
-        tm.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, np.int32).ravel())
-        tm.polygons.add(t)
-        tm.polygons.foreach_set("loop_start", np.arange(0, 3 * t, 3, dtype=np.int32))
-        tm.update(calc_edges=True)
-        # The normals as a float attribute ("free" custom normals): exact, where
-        # normals_split_custom_set would encode them in 16 bits, through a Python list.
-        custom = tm.attributes.new("custom_normal", "FLOAT_VECTOR", "CORNER")
-        custom.data.foreach_set("vector", np.ascontiguousarray(corner_normals, np.float32).ravel())
-        for k, (name, table) in enumerate(layers.items()):
-            # A layer per map: Blender keeps the tangents it computed for a layer's name.
-            uv = tm.uv_layers.new(name=f"uv{k}")
-            uv.uv.foreach_set("vector", np.ascontiguousarray(table.corners(0, t), np.float32).ravel())
-            tm.calc_tangents(uvmap=uv.name)
-            values = np.empty((3 * t, 4), np.float32)
-            values[:, :3] = _get(tm.loops, "tangent", np.float32, 9 * t).reshape(-1, 3)
-            values[:, 3] = _get(tm.loops, "bitangent_sign", np.float32, 3 * t)
-            attributes[TANGENT_PREFIX + name] = CornerTable(values, np.arange(3 * t).reshape(t, 3))
-    finally:
-        bpy.data.meshes.remove(tm)
+    corner_normals = normals.corners(0, t)
+    for name, table in layers.items():
+        values = mikktspace(vertices, triangles, corner_normals, table.corners(0, t))
+        attributes[TANGENT_PREFIX + name] = CornerTable(values, np.arange(3 * t).reshape(t, 3))
     return note
 
 

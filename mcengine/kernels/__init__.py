@@ -13,6 +13,7 @@ that ``mcengine.packing`` builds.  One module per concept:
 * ``motion``          motion blur: shutter times and interpolated transforms
 * ``surface``         the shading point: hit position, normals, local frame
 * ``displace``        true displacement of mesh vertices
+* ``tangents``        MikkTSpace tangents of a mesh (for the export; Blender's algorithm, one order)
 * ``lights``          lamp shapes and emissive triangles: sampling, intersection, importance
 * ``ies``             IES light profiles
 * ``light_sampling``  which light next-event estimation picks, and MIS weights

@@ -721,6 +721,93 @@ def test_tangents_of_a_mesh_with_custom_normals_are_blenders_own(scene, fake_ses
     np.testing.assert_allclose(tangent[:, :3], expected.reshape(-1, 3)[loops], atol=1e-6)
 
 
+def _blender_tangents_of_triangles(verts, tris, corner_normals, uvs):
+    """``Mesh.calc_tangents`` of a mesh of these triangles (faces of 3 corners), with these
+    corner normals (a float "custom_normal" attribute keeps them exactly) and UVs."""
+    t = len(tris)
+    me = bpy.data.meshes.new("triangles")
+    try:
+        me.vertices.add(len(verts))
+        me.vertices.foreach_set("co", np.ascontiguousarray(verts, np.float32).ravel())
+        me.loops.add(3 * t)
+        me.loops.foreach_set("vertex_index", np.ascontiguousarray(tris, np.int32).ravel())
+        me.polygons.add(t)
+        me.polygons.foreach_set("loop_start", np.arange(0, 3 * t, 3, dtype=np.int32))
+        me.update(calc_edges=True)
+        normals = me.attributes.new("custom_normal", "FLOAT_VECTOR", "CORNER")
+        normals.data.foreach_set("vector", np.ascontiguousarray(corner_normals, np.float32).ravel())
+        me.uv_layers.new(name="UV").uv.foreach_set("vector", np.ascontiguousarray(uvs, np.float32).ravel())
+        me.calc_tangents(uvmap="UV")
+        out = np.empty((3 * t, 4), np.float32)
+        values = np.empty(9 * t, np.float32)
+        me.loops.foreach_get("tangent", values)
+        out[:, :3] = values.reshape(-1, 3)
+        me.loops.foreach_get("bitangent_sign", out[:, 3])
+        return out
+    finally:
+        bpy.data.meshes.remove(me)
+
+
+def _suzanne_triangles(levels, rng=None):
+    """Positions, triangles, corner normals and UVs of a smooth Suzanne subdivided
+    ``levels`` times (its own UV map; with ``rng``, a third of the UVs mirrored and two
+    triangles made degenerate)."""
+    bpy.ops.mesh.primitive_monkey_add()
+    ob = bpy.context.object
+    if levels:
+        ob.modifiers.new("Subdivision", "SUBSURF").levels = levels
+    bpy.ops.object.shade_smooth()
+    me = ob.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
+    me.calc_loop_triangles()
+    loops = _blender_triangles(me)[0]
+    corners = np.empty(len(me.loops), np.int32)
+    me.loops.foreach_get("vertex_index", corners)
+    verts = np.empty(3 * len(me.vertices), np.float32)
+    me.vertices.foreach_get("co", verts)
+    normals = np.empty(3 * len(me.loops), np.float32)
+    me.corner_normals.foreach_get("vector", normals)
+    uvs = np.empty(2 * len(me.loops), np.float32)
+    me.uv_layers.active.uv.foreach_get("vector", uvs)
+    tris = corners[loops].reshape(-1, 3)
+    uvs = uvs.reshape(-1, 2)[loops]
+    if rng is not None:
+        uvs[rng.random(len(uvs)) < 1 / 3, 0] *= -1.0
+        tris[[5, 40]] = tris[[5, 40]][:, [0, 0, 2]]
+    return verts.reshape(-1, 3), tris, normals.reshape(-1, 3)[loops], uvs
+
+
+@pytest.mark.parametrize("levels, seed", [(0, None), (1, None), (1, 7)])
+def test_mikktspace_gives_blenders_bits(scene, levels, seed):
+    """kernels.tangents computes MikkTSpace as Blender's intern/mikktspace does on one
+    thread (meshes of at most 10,000 faces): the same bits, mirrored UVs and degenerate
+    triangles included."""
+    from mcengine.kernels.tangents import mikktspace
+    rng = None if seed is None else np.random.default_rng(seed)
+    verts, tris, normals, uvs = _suzanne_triangles(levels, rng)
+    assert len(tris) <= 10_000
+    expected = _blender_tangents_of_triangles(verts, tris, normals, uvs)
+    np.testing.assert_array_equal(mikktspace(verts, tris, normals, uvs), expected)
+
+
+def test_tangents_of_a_large_mesh_are_the_same_bits_every_time(scene, fake_session):
+    """Above 10,000 faces Blender's calc_tangents sums on threads in varying order (its
+    results differ in the last bit on a few hundred corners from call to call, mostly in a
+    process's first calls); the export's tangents are those of the serial order
+    (kernels.tangents, which the test above checks against Blender), so they do not vary, and
+    are Blender's to that last bit."""
+    from mcengine.kernels.tangents import mikktspace
+    verts, tris, normals, uvs = _suzanne_triangles(2)
+    assert len(tris) > 10_000
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(_normal_map_material())
+    first = export_scene(fake_session).geometry.attributes["tangent:"].reshape(-1, 4)
+    assert first.tobytes() == mikktspace(verts, tris, normals, uvs).tobytes()
+    again = export_scene(fake_session).geometry.attributes["tangent:"].reshape(-1, 4)
+    assert again.tobytes() == first.tobytes()
+    blender = _blender_tangents_of_triangles(verts, tris, normals, uvs)
+    np.testing.assert_allclose(first, blender, rtol=0, atol=3e-7)
+
+
 def test_tangent_nodes_along_a_uv_map_get_its_tangents(scene, fake_session):
     """A Tangent node along a UV map reads the same tangents; a radial one none."""
     ob = new_mesh_object("Quad", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])

@@ -56,7 +56,7 @@ def mikktspace(positions, triangles, normals, uvs) -> np.ndarray:
     corner: (T, 3, 3) or (3T, 3), and (T, 3, 2) or (3T, 2).  Arithmetic is single precision,
     as Blender's.
     """
-    tri = np.ascontiguousarray(triangles, np.int64).reshape(-1, 3)
+    tri = np.ascontiguousarray(triangles, np.int32).reshape(-1, 3)
     if len(tri) == 0:
         return np.zeros((0, 4), np.float32)
     p = np.ascontiguousarray(np.asarray(positions, np.float32)[tri].reshape(-1, 3))
@@ -64,12 +64,16 @@ def mikktspace(positions, triangles, normals, uvs) -> np.ndarray:
     uv = np.ascontiguousarray(uvs, np.float32).reshape(-1, 2)
     if len(n) != len(p) or len(uv) != len(p):
         raise ValueError("mikktspace: normals and uvs need one row per triangle corner")
+    return _tangent_spaces(p, n, uv, _welded(p, n, uv))
+
+
+def _welded(p, n, uv) -> np.ndarray:
+    """Each corner's representative corner (int32); the keys and hashes, 40 bytes a corner,
+    are freed on return."""
     # Welding compares floats: -0 equals +0 (adding +0 makes every zero +0).
-    key = np.concatenate([p, n, uv], axis=1) + np.float32(0.0)
-    bits = key.view(np.uint32)
+    bits = (np.concatenate([p, n, uv], axis=1) + np.float32(0.0)).view(np.uint32)
     h = _row_hashes(bits)
-    weld = _weld(bits, h, np.argsort(h, kind="stable"))
-    return _tangent_spaces(p, n, uv, weld)
+    return _weld(bits, h, np.argsort(h, kind="stable"))
 
 
 @builder
@@ -87,7 +91,7 @@ def _row_hashes(bits):
 def _weld(bits, h, order):
     """Each corner's representative: the first corner with the same bits."""
     m = order.shape[0]
-    rep = np.empty(m, np.int64)
+    rep = np.empty(m, np.int32)
     s = 0
     while s < m:
         e = s + 1
@@ -140,7 +144,7 @@ def _tangent_spaces(p, n, uv, weld):
     corners = p.shape[0]
     t_all = corners // 3
     # -- degenerate triangles last, the good ones in their order -----------------------------
-    order = np.empty(t_all, np.int64)
+    order = np.empty(t_all, np.int32)
     ng = 0
     for t in range(t_all):
         a, b, c = weld[3 * t], weld[3 * t + 1], weld[3 * t + 2]
@@ -153,7 +157,7 @@ def _tangent_spaces(p, n, uv, weld):
         if _same(p, a, b) or _same(p, a, c) or _same(p, b, c):
             order[nd] = t
             nd += 1
-    vid = np.empty((ng, 3), np.int64)
+    vid = np.empty((ng, 3), np.int32)
     for k in range(ng):
         for i in range(3):
             vid[k, i] = weld[3 * order[k] + i]
@@ -186,7 +190,7 @@ def _tangent_spaces(p, n, uv, weld):
                     any_group[k] = False
 
     # -- neighbours across shared edges ----------------------------------------------------------
-    nbr = np.full((ng, 3), -1, np.int64)
+    nbr = np.full((ng, 3), -1, np.int32)
     keys = np.empty(3 * ng, np.int64)
     for k in range(ng):
         for i in range(3):
@@ -214,11 +218,11 @@ def _tangent_spaces(p, n, uv, weld):
         s = e
 
     # -- groups around each welded vertex ----------------------------------------------------------
-    group = np.full((ng, 3), -1, np.int64)
-    g_vertex = np.empty(3 * ng, np.int64)
+    group = np.full((ng, 3), -1, np.int32)
+    g_vertex = np.empty(3 * ng, np.int32)
     g_orient = np.zeros(3 * ng, np.bool_)
     n_groups = 0
-    stack = np.empty(3 * ng + 2, np.int64)
+    stack = np.empty(3 * ng + 2, np.int32)
     for k in range(ng):
         for i in range(3):
             if any_group[k] or group[k, i] != -1:
@@ -278,7 +282,7 @@ def _tangent_spaces(p, n, uv, weld):
     # -- the corners' tangent spaces -------------------------------------------------------------
     ts = np.zeros((corners, 3), np.float32)
     ts[:, 0] = _ONE
-    count = np.zeros(corners, np.int64)
+    count = np.zeros(corners, np.int32)
     ts_orient = np.zeros(corners, np.bool_)
     for k in range(ng):
         for i in range(3):
@@ -295,7 +299,7 @@ def _tangent_spaces(p, n, uv, weld):
             ts_orient[r] = g_orient[g]
     # Degenerate triangles: each corner copies the first good corner of its welded vertex.
     if ng < t_all:
-        first = np.full(corners, -1, np.int64)
+        first = np.full(corners, -1, np.int32)
         for k in range(ng):
             for i in range(3):
                 if first[vid[k, i]] == -1:

@@ -144,19 +144,20 @@ def _tangent_spaces(p, n, uv, weld):
     corners = p.shape[0]
     t_all = corners // 3
     # -- degenerate triangles last, the good ones in their order -----------------------------
+    degenerate = np.empty(t_all, np.bool_)
+    for t in range(t_all):
+        a, b, c = weld[3 * t], weld[3 * t + 1], weld[3 * t + 2]
+        degenerate[t] = _same(p, a, b) or _same(p, a, c) or _same(p, b, c)
+    ng = t_all - int(degenerate.sum())
     order = np.empty(t_all, np.int32)
-    ng = 0
+    good, bad = 0, ng
     for t in range(t_all):
-        a, b, c = weld[3 * t], weld[3 * t + 1], weld[3 * t + 2]
-        if not (_same(p, a, b) or _same(p, a, c) or _same(p, b, c)):
-            order[ng] = t
-            ng += 1
-    nd = ng
-    for t in range(t_all):
-        a, b, c = weld[3 * t], weld[3 * t + 1], weld[3 * t + 2]
-        if _same(p, a, b) or _same(p, a, c) or _same(p, b, c):
-            order[nd] = t
-            nd += 1
+        if degenerate[t]:
+            order[bad] = t
+            bad += 1
+        else:
+            order[good] = t
+            good += 1
     vid = np.empty((ng, 3), np.int32)
     for k in range(ng):
         for i in range(3):

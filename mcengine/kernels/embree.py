@@ -129,7 +129,7 @@ def _load() -> _Library | None:
 
 
 def build(vertices, triangles, packets: bool = True, masks=None, spatial_splits: bool = False,
-          compact: bool = False):
+          compact: bool = False, robust: bool = True):
     """A committed Embree scene of these triangles, with ``closest`` and ``occluded``.
 
     vertices : (V, 3) float32-convertible; triangles : (T, 3) int, T > 0.
@@ -140,12 +140,14 @@ def build(vertices, triangles, packets: bool = True, masks=None, spatial_splits:
     BVH settings.  The library's BVH is built as Cycles builds it (bvh/embree.cpp): robust,
     medium build quality, high with ``spatial_splits`` (Cycles' Use Spatial Splits), and
     Embree's compact layout with ``compact`` (Use Compact BVH: at 4 million triangles 136 MB
-    instead of 246 MB, traversed more slowly).
+    instead of 246 MB, traversed more slowly).  ``robust=False`` builds Embree's fast,
+    not watertight mode, which renders never use (``benchmarks/bench_embree_floor.py``
+    measures what it would save; embreex's fallback is always robust).
     """
     library = _load() if packets else None
     if library is None:
         return _EmbreexScene(vertices, triangles)
-    return _PacketScene(library, vertices, triangles, masks, spatial_splits, compact)
+    return _PacketScene(library, vertices, triangles, masks, spatial_splits, compact, robust)
 
 
 def build_local(vertices, triangles):
@@ -174,7 +176,7 @@ class _PacketScene:
     geometry's to the caller's numbering."""
 
     def __init__(self, library: _Library, vertices, triangles, masks=None,
-                 spatial_splits: bool = False, compact: bool = False):
+                 spatial_splits: bool = False, compact: bool = False, robust: bool = True):
         lib = library.lib
         self._library = library
         vertices = np.asarray(vertices, np.float32)
@@ -198,7 +200,8 @@ class _PacketScene:
             triangles = triangles.view(np.uint32)
         self._triangles = np.ascontiguousarray(triangles, np.uint32)
         self._scene = lib.rtcNewScene(library.device)
-        lib.rtcSetSceneFlags(self._scene, _SCENE_FLAG_ROBUST | (_SCENE_FLAG_COMPACT if compact else 0))
+        lib.rtcSetSceneFlags(self._scene, (_SCENE_FLAG_ROBUST if robust else 0)
+                             | (_SCENE_FLAG_COMPACT if compact else 0))
         quality = _BUILD_QUALITY_HIGH if spatial_splits else _BUILD_QUALITY_MEDIUM
         lib.rtcSetSceneBuildQuality(self._scene, quality)
         ends = [*self._first[1:], len(self._triangles)]

@@ -82,11 +82,9 @@ def test_float64_refinement_is_exact_on_a_known_hit():
     assert (t, b1, b2) == (3.0, 0.25, 0.125)
 
 
-@backends
-def test_rays_aimed_at_shared_edges_and_vertices_never_leak(packets):
-    """Watertightness: from inside a closed mesh, rays aimed exactly at its shared
-    edges and vertices must hit it (Embree's fast, non-robust mode lets about one
-    in ten through here; the renderer uses the robust mode)."""
+def _rays_at_shared_edges():
+    """A closed sphere's vertices and triangles, and batches of rays (o, d) from inside it
+    aimed exactly at its shared edges and vertices."""
     from .scenes import uv_sphere
     tris, _ = uv_sphere(1.0, 24, 12)
     v, inv = np.unique(np.round(tris.reshape(-1, 3), 12), axis=0, return_inverse=True)
@@ -96,15 +94,36 @@ def test_rays_aimed_at_shared_edges_and_vertices_never_leak(packets):
                         for t in idx for a, b in ((0, 1), (1, 2), (2, 0)) for f in (0.0, 0.25, 0.5)],
                        np.float32)
     rng = np.random.default_rng(0)
-    accel = Accel(verts, idx, packets=packets)
+    batches = []
     for spread in (0.0, 0.1, 0.3):
         o = rng.standard_normal(targets.shape) * spread
         o *= np.minimum(1.0, 0.5 / np.maximum(np.linalg.norm(o, axis=1, keepdims=True), 1e-9))
         o = o.astype(np.float32)        # origins well inside the sphere
         d = targets - o
-        d = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
+        batches.append((o, (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)))
+    return verts, idx, batches
+
+
+@backends
+def test_rays_aimed_at_shared_edges_and_vertices_never_leak(packets):
+    """Watertightness: from inside a closed mesh, rays aimed exactly at its shared
+    edges and vertices must hit it (the renderer uses Embree's robust mode)."""
+    verts, idx, batches = _rays_at_shared_edges()
+    accel = Accel(verts, idx, packets=packets)
+    for o, d in batches:
         prim = accel.closest(o, d, np.full(len(o), 1e30, np.float32))
         assert np.all(prim >= 0), f"{int((prim < 0).sum())} of {len(o)} rays leaked"
+
+
+def test_the_fast_mode_leaks_where_the_robust_one_does_not():
+    """What the robust mode buys: Embree's fast mode (``robust=False``, which only the
+    benchmarks build) lets several percent of those rays slip between the triangles."""
+    verts, idx, batches = _rays_at_shared_edges()
+    fast = embree.build(verts, idx, robust=False)
+    o = np.concatenate([b[0] for b in batches])
+    d = np.concatenate([b[1] for b in batches])
+    leaked = int((fast.closest(o, d, np.full(len(o), 1e30, np.float32)) < 0).sum())
+    assert leaked > 0.02 * len(o), f"{leaked} of {len(o)} rays leaked"
 
 
 def test_packets_are_the_default_and_agree_with_embreex_ray_for_ray():

@@ -13,11 +13,12 @@ thread), with the BVH built two ways:
   ``RTC_SCENE_FLAG_NONE``, ``RTC_BUILD_QUALITY_HIGH``).
 
 In the same run, alternating round by round, it renders the box with MC Engine
-(``RenderSession``, two threads) and with Mitsuba (its child process, two threads, JIT
-compile excluded as in bench_cornell.py) and prints each engine's time per path on one
-core (wall time of the render itself x 2 cores / paths), beside Embree's time per path of MC Engine's rays.
-Mitsuba counts its own rays per path (its Russian roulette differs), so times per ray are
-printed too.
+(``RenderSession``, two threads), Cycles (through Blender, two threads: a full render's
+time less a 1-sample render's) and Mitsuba (its child process, two threads, JIT compile
+excluded as in bench_cornell.py) and prints each engine's time per path on one core (the
+render's wall time x 2 cores / paths), beside Embree's time per path of MC Engine's rays.
+Cycles traces MC Engine's paths (the same rules); Mitsuba counts its own rays per path (its
+Russian roulette differs), so times per ray are printed too.
 
 Run: python benchmarks/bench_embree_floor.py [--samples N] [--record-samples N]
                                              [--rounds R] [--materials file|principled]
@@ -55,15 +56,26 @@ class _Recorder:
         return self._accel.occluded(o, d, t, times, mask)
 
 
-def _export(materials: str):
-    """The Cornell box as MC Engine exports it (a SceneDescription)."""
+def _blender_render(materials: str, engine_name: str, samples: int):
+    """Render the Cornell box through Blender (bpy as a module); the render's result."""
     import bpy
 
-    from mcengine_blender import engine
     from mcengine_blender.batch.render import ensure_registered, open_scene, render_scene
     from mcengine_blender.batch.settings import make_unbiased
 
     ensure_registered()
+    scene = open_scene(bench_cornell.SCENE)
+    make_unbiased(scene)
+    if materials == "principled":
+        bench_cornell.to_default_principled(bpy)
+    return render_scene(scene, engine_name, samples=samples, seed=0,
+                        resolution=(RESOLUTION, RESOLUTION))
+
+
+def _export(materials: str):
+    """The Cornell box as MC Engine exports it (a SceneDescription)."""
+    from mcengine_blender import engine
+
     scenes, real_factory = [], engine.session_factory
 
     def recording_factory(desc, threads=None):
@@ -72,14 +84,17 @@ def _export(materials: str):
 
     engine.session_factory = recording_factory
     try:
-        scene = open_scene(bench_cornell.SCENE)
-        make_unbiased(scene)
-        if materials == "principled":
-            bench_cornell.to_default_principled(bpy)
-        render_scene(scene, "mcengine", samples=1, seed=0, resolution=(RESOLUTION, RESOLUTION))
+        _blender_render(materials, "mcengine", 1)
     finally:
         engine.session_factory = real_factory
     return scenes[-1]
+
+
+def _cycles_seconds(materials: str, samples: int) -> float:
+    """Cycles' marginal render time of ``samples`` - 1 samples per pixel (a full render's
+    time less a 1-sample render's: its scene sync left out)."""
+    one = _blender_render(materials, "cycles", 1).seconds
+    return _blender_render(materials, "cycles", samples).seconds - one
 
 
 def _record(desc, samples: int):
@@ -127,7 +142,7 @@ def main(argv=None) -> int:
                                                    spatial_splits=True)}
     desc.integrator.samples = args.samples
     paths = RESOLUTION * RESOLUTION * args.samples
-    per_path = {name: [] for name in (*bvhs, "MC Engine", "Mitsuba")}
+    per_path = {name: [] for name in (*bvhs, "MC Engine", "Cycles", "Mitsuba")}
 
     with contextlib.ExitStack() as stack:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bench_floor_")))
@@ -139,9 +154,10 @@ def main(argv=None) -> int:
             return 2
         peer.render(args.samples, 0)                       # compiles Mitsuba's kernels
         RenderSession(desc, threads=CORES).run()           # loads MC Engine's
+        _cycles_seconds(args.materials, 2)                 # and Cycles' kernels
         for r in range(args.rounds):
-            steps = ["bvh", "mc", "mitsuba"]
-            for step in steps[r % 3:] + steps[:r % 3]:
+            steps = ["bvh", "mc", "cycles", "mitsuba"]
+            for step in steps[r % 4:] + steps[:r % 4]:
                 if step == "bvh":
                     for name, scene in bvhs.items():
                         per_path[name].append(_trace_seconds(scene, batches) / recorded_paths)
@@ -150,6 +166,9 @@ def main(argv=None) -> int:
                     t0 = time.perf_counter()
                     session.run()
                     per_path["MC Engine"].append((time.perf_counter() - t0) * CORES / paths)
+                elif step == "cycles":
+                    seconds = _cycles_seconds(args.materials, args.samples)
+                    per_path["Cycles"].append(seconds * CORES / (paths - RESOLUTION ** 2))
                 else:
                     reply = peer.render(args.samples, r + 1)
                     seconds = reply["seconds"] - reply["compile"]
@@ -162,13 +181,14 @@ def main(argv=None) -> int:
           f"{args.samples} spp, medians of {args.rounds} rounds; Embree traced the "
           f"{rays} rays of a {args.record_samples}-spp render ({ours:.2f} rays/path)")
     print(f"{'time per path on one core':50s}{'us/path':>9s}{'ns/ray':>9s}"
-          f"{'of Mitsuba path':>17s}")
+          f"{'of Mitsuba path':>17s}{'of Cycles path':>16s}")
     rows = [("MC Engine render", med["MC Engine"], ours),
+            ("Cycles render (marginal; MC Engine's rays)", med["Cycles"], ours),
             ("Mitsuba 3 render", med["Mitsuba"], mitsuba_rays)]
     rows += [(f"Embree alone, {name}", med[name], ours) for name in bvhs]
     for name, seconds, rays_per_path in rows:
         print(f"{name:50s}{seconds * 1e6:9.3f}{seconds / rays_per_path * 1e9:9.1f}"
-              f"{seconds / med['Mitsuba']:16.2f}x")
+              f"{seconds / med['Mitsuba']:16.2f}x{seconds / med['Cycles']:15.2f}x")
     print(f"Mitsuba traces {mitsuba_rays:.2f} rays/path (its stopping rules replayed); "
           f"MC Engine {ours:.2f}")
     return 0

@@ -798,7 +798,6 @@ def test_tangents_of_a_large_mesh_are_the_same_bits_every_time(scene, fake_sessi
     from mcengine.kernels.tangents import mikktspace
     verts, tris, normals, uvs = _suzanne_triangles(2)
     assert len(tris) > 10_000
-    bpy.ops.object.shade_smooth()
     bpy.context.object.data.materials.append(_normal_map_material())
     first = export_scene(fake_session).geometry.attributes["tangent:"].reshape(-1, 4)
     assert first.tobytes() == mikktspace(verts, tris, normals, uvs).tobytes()

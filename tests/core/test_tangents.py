@@ -77,7 +77,7 @@ def test_a_degenerate_triangle_copies_the_tangent_of_its_welded_vertex():
     np.testing.assert_array_equal(out[7], out[2])        # vertex 4 welds with vertex 2
 
 
-def test_triangles_without_uv_area_take_their_neighbours_tangent():
+def test_a_triangle_without_uv_area_and_no_welded_neighbour_gets_the_default_tangent():
     uv = _uvs(lambda x, y: (x, y))
     uv[3:] = 0.5                                 # triangle 1: every corner the same UV
     out = mikktspace(SQUARE, TRIS, UP, uv)
@@ -87,7 +87,11 @@ def test_triangles_without_uv_area_take_their_neighbours_tangent():
     np.testing.assert_array_equal(out[3:], [(1, 0, 0, -1)] * 3)
 
 
-def test_same_mesh_same_bits_and_empty_mesh():
+def test_random_meshes_give_finite_tangents_and_bad_inputs_are_refused():
+    """Degenerate and repeated indices give finite tangents; an empty mesh gives none; rows
+    that do not match the corners are refused.  (Two calls giving the same bits cannot fail
+    for this serial code; the export's determinism, where Blender's threads once made it
+    fail, is asserted in tests/addon/test_export_mesh.py.)"""
     rng = np.random.default_rng(1)
     verts = rng.random((3000, 3)).astype(np.float32)
     tris = rng.integers(0, 3000, size=(12000, 3))

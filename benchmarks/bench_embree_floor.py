@@ -18,7 +18,10 @@ time less a 1-sample render's) and Mitsuba (its child process, two threads, JIT 
 excluded as in bench_cornell.py) and prints each engine's time per path on one core (the
 render's wall time x 2 cores / paths), beside Embree's time per path of MC Engine's rays.
 Cycles traces MC Engine's paths (the same rules); Mitsuba counts its own rays per path (its
-Russian roulette differs), so times per ray are printed too.
+Russian roulette differs), so times per ray are printed too.  With ``--materials principled``
+the rounds also render the file's Lambert box with MC Engine: what the Principled box would
+cost if its material cost no more than Lambert's, beside Cycles' Principled paths (issue 9
+asks for half their time).
 
 Run: python benchmarks/bench_embree_floor.py [--samples N] [--record-samples N]
                                              [--rounds R] [--materials file|principled]
@@ -143,6 +146,10 @@ def main(argv=None) -> int:
     desc.integrator.samples = args.samples
     paths = RESOLUTION * RESOLUTION * args.samples
     per_path = {name: [] for name in (*bvhs, "MC Engine", "Cycles", "Mitsuba")}
+    lambert = _export("file") if args.materials == "principled" else None
+    if lambert is not None:
+        lambert.integrator.samples = args.samples
+        per_path["MC Engine, Lambert"] = []
 
     with contextlib.ExitStack() as stack:
         folder = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="bench_floor_")))
@@ -156,16 +163,19 @@ def main(argv=None) -> int:
         RenderSession(desc, threads=CORES).run()           # loads MC Engine's
         _cycles_seconds(args.materials, 2)                 # and Cycles' kernels
         for r in range(args.rounds):
-            steps = ["bvh", "mc", "cycles", "mitsuba"]
-            for step in steps[r % 4:] + steps[:r % 4]:
+            steps = ["bvh", "mc", "cycles", "mitsuba"] + (["mc_lambert"] if lambert else [])
+            for step in steps[r % len(steps):] + steps[:r % len(steps)]:
                 if step == "bvh":
                     for name, scene in bvhs.items():
                         per_path[name].append(_trace_seconds(scene, batches) / recorded_paths)
-                elif step == "mc":
-                    session = RenderSession(desc, threads=CORES)
+                elif step in ("mc", "mc_lambert"):
+                    session = RenderSession(desc if step == "mc" else lambert, threads=CORES)
                     t0 = time.perf_counter()
                     session.run()
-                    per_path["MC Engine"].append((time.perf_counter() - t0) * CORES / paths)
+                    name = "MC Engine" if step == "mc" else "MC Engine, Lambert"
+                    per_path[name].append((time.perf_counter() - t0) * CORES / paths)
+                    if step == "mc_lambert":
+                        lambert_rays = session.stats.rays / session.stats.paths
                 elif step == "cycles":
                     seconds = _cycles_seconds(args.materials, args.samples)
                     per_path["Cycles"].append(seconds * CORES / (paths - RESOLUTION ** 2))
@@ -185,6 +195,9 @@ def main(argv=None) -> int:
     rows = [("MC Engine render", med["MC Engine"], ours),
             ("Cycles render (marginal; MC Engine's rays)", med["Cycles"], ours),
             ("Mitsuba 3 render", med["Mitsuba"], mitsuba_rays)]
+    if lambert is not None:
+        rows.insert(1, ("MC Engine render, the file's Lambert materials",
+                        med["MC Engine, Lambert"], lambert_rays))
     rows += [(f"Embree alone, {name}", med[name], ours) for name in bvhs]
     for name, seconds, rays_per_path in rows:
         print(f"{name:50s}{seconds * 1e6:9.3f}{seconds / rays_per_path * 1e9:9.1f}"

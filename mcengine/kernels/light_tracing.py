@@ -93,7 +93,7 @@ from .state import (
     ST_BOUNCE_RAYS,
     ST_SELF_HITS,
     ST_SHADOW_RAYS,
-    move_path,
+    compact_paths,
 )
 from .surface import hit_distance, past_self_hit, surface_point
 from .svm import OBJ_HOLDOUT, shader_scene
@@ -416,11 +416,5 @@ def splat_joined(nq, occluded, sq, film, table, cfg, n_pixels):
 @kernel
 def compact_light_paths(n, st):
     """Move the live light paths to the front; returns how many there are."""
-    m = 0
-    for i in range(n):
-        if not st.alive[i]:
-            continue
-        if m != i:
-            move_path(st, i, m)
-        m += 1
+    m, _ = compact_paths(st, n)
     return m

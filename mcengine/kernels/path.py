@@ -158,7 +158,7 @@ from .state import (
     ST_BOUNCE_RAYS,
     ST_CAMERA_RAYS,
     ST_SELF_HITS,
-    move_path,
+    compact_paths,
 )
 from .subsurface import disk_probe, random_walk
 from .surface import hit_distance, past_self_hit, surface_point
@@ -658,20 +658,17 @@ def finish_bounce(n, n_shadow, occluded, st, sq, film_sum, film_sq, film_n, pd, 
             if split:
                 shadow_pass(pd, fp, st.pixel[i], pb, s, kind, sq.contrib[s, 0], sq.contrib[s, 1],
                             sq.contrib[s, 2])
-    move_passes = pb.pw.shape[0] > 1
-    m = 0
     for i in range(n):
-        if st.alive[i]:
-            if m != i:
-                move_path(st, i, m)
-                if move_passes:
-                    for c in range(6):
-                        pb.pw[m, c] = pb.pw[i, c]
-                    for c in range(3):
-                        pb.dn[m, c] = pb.dn[i, c]
-            m += 1
-        else:
+        if not st.alive[i]:
             _splat(st, i, film_sum, film_sq, film_n)
+    m, first = compact_paths(st, n)
+    if pb.pw.shape[0] > 1:
+        for j in range(first, m):
+            i = st.live[j]
+            for c in range(6):
+                pb.pw[j, c] = pb.pw[i, c]
+            for c in range(3):
+                pb.dn[j, c] = pb.dn[i, c]
     return m
 
 

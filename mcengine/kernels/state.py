@@ -47,6 +47,7 @@ PathState = namedtuple("PathState", [
     "o32",           # (B, 3) f32    Embree input: origins
     "d32",           # (B, 3) f32    Embree input: directions
     "t32",           # (B,) f32      Embree input: tfar
+    "live",          # (B,) int32    compaction's scratch: the old slots of the live paths
 ])
 
 # What a shadow ray's light is for (ShadowQueue.kind): Combined only, Combined and the
@@ -223,42 +224,83 @@ def alloc_path_state(n: int) -> PathState:
         mis_set=np.zeros(n, np.int32),
         dp=np.zeros(n), dd=np.zeros(n), time=np.zeros(n), alive=np.zeros(n, np.uint8),
         o32=np.zeros((n, 3), np.float32), d32=np.zeros((n, 3), np.float32),
-        t32=np.zeros(n, np.float32))
+        t32=np.zeros(n, np.float32), live=np.zeros(n, np.int32))
 
 
 @device
-def move_path(st, i, m):
-    """Move path i's state to slot m (compaction): every field but ``root``, which only the
-    classic integrators use and keep in their own order."""
-    st.key[m] = st.key[i]
-    st.pixel[m] = st.pixel[i]
-    for c in range(3):
-        st.ray_o[m, c] = st.ray_o[i, c]
-        st.ray_d[m, c] = st.ray_d[i, c]
-        st.beta[m, c] = st.beta[i, c]
-        st.radiance[m, c] = st.radiance[i, c]
-        st.mis_p[m, c] = st.mis_p[i, c]
-        st.mis_p[m, c + 3] = st.mis_p[i, c + 3]
-        st.o32[m, c] = st.o32[i, c]
-        st.d32[m, c] = st.d32[i, c]
-    st.ray_tmax[m] = st.ray_tmax[i]
-    st.mis_total[m] = st.mis_total[i]
-    st.transparency[m] = st.transparency[i]
-    st.bounce[m] = st.bounce[i]
-    st.diffuse[m] = st.diffuse[i]
-    st.glossy[m] = st.glossy[i]
-    st.transmission[m] = st.transmission[i]
-    st.transparent[m] = st.transparent[i]
-    st.flags[m] = st.flags[i]
-    st.mis_pdf[m] = st.mis_pdf[i]
-    st.min_pdf[m] = st.min_pdf[i]
-    st.self_prim[m] = st.self_prim[i]
-    st.mis_set[m] = st.mis_set[i]
-    st.dp[m] = st.dp[i]
-    st.dd[m] = st.dd[i]
-    st.time[m] = st.time[i]
-    st.alive[m] = st.alive[i]
-    st.t32[m] = st.t32[i]
+def live_slots(st, n):
+    """Write the slots of the live paths among the first n to ``st.live``, in order;
+    returns (their count m, the first slot that a compaction changes: n if none)."""
+    m = 0
+    first = n
+    for i in range(n):
+        if st.alive[i]:
+            st.live[m] = i
+            if m != i and first == n:
+                first = m
+            m += 1
+    return m, first
+
+
+@device
+def gather_rows(a, live, first, m):
+    """a[j] = a[live[j]] for j in [first, m): one field's compaction (live[j] >= j, so
+    the copy runs forward in place)."""
+    for j in range(first, m):
+        a[j] = a[live[j]]
+
+
+@device
+def gather_rows3(a, live, first, m):
+    """``gather_rows`` of an (N, 3) field."""
+    for j in range(first, m):
+        i = live[j]
+        a[j, 0] = a[i, 0]
+        a[j, 1] = a[i, 1]
+        a[j, 2] = a[i, 2]
+
+
+@device
+def compact_paths(st, n):
+    """Move the live paths among the first n to the front, in order; returns (their count,
+    the first slot that moved: n if none).  Field by field, each a short loop over
+    ``st.live``: every field but ``root``, which only the classic integrators use and keep
+    in their own order."""
+    m, first = live_slots(st, n)
+    if first >= m:
+        return m, first
+    live = st.live
+    gather_rows(st.key, live, first, m)
+    gather_rows(st.pixel, live, first, m)
+    gather_rows3(st.ray_o, live, first, m)
+    gather_rows3(st.ray_d, live, first, m)
+    gather_rows(st.ray_tmax, live, first, m)
+    gather_rows3(st.beta, live, first, m)
+    gather_rows3(st.radiance, live, first, m)
+    gather_rows(st.transparency, live, first, m)
+    gather_rows(st.bounce, live, first, m)
+    gather_rows(st.diffuse, live, first, m)
+    gather_rows(st.glossy, live, first, m)
+    gather_rows(st.transmission, live, first, m)
+    gather_rows(st.transparent, live, first, m)
+    gather_rows(st.flags, live, first, m)
+    gather_rows(st.mis_pdf, live, first, m)
+    gather_rows(st.min_pdf, live, first, m)
+    for j in range(first, m):
+        i = live[j]
+        for c in range(6):
+            st.mis_p[j, c] = st.mis_p[i, c]
+    gather_rows(st.mis_total, live, first, m)
+    gather_rows(st.self_prim, live, first, m)
+    gather_rows(st.mis_set, live, first, m)
+    gather_rows(st.dp, live, first, m)
+    gather_rows(st.dd, live, first, m)
+    gather_rows(st.time, live, first, m)
+    gather_rows(st.alive, live, first, m)
+    gather_rows3(st.o32, live, first, m)
+    gather_rows3(st.d32, live, first, m)
+    gather_rows(st.t32, live, first, m)
+    return m, first
 
 
 def alloc_shadow_queue(n: int) -> ShadowQueue:

@@ -18,7 +18,8 @@ Work is split into passes (1, 1, 2, 4, ... samples per pixel, so the first
 image appears at once; after the first, the rest in one pass once it is at most
 ``QUICK_FINISH_PATHS`` paths, a fraction of a second, unless a time limit asks for
 finer steps) and each pass into chunks of at most ``batch_size`` paths over
-disjoint pixel ranges, traced by one worker thread each.  The schedule depends
+disjoint pixel ranges, shrinking towards the pass's end so that the workers finish
+it together (``_chunks``), traced by one worker thread each.  The schedule depends
 only on the scene and settings, so the same seed gives the same image for any
 number of threads.
 """
@@ -466,10 +467,9 @@ class RenderSession:
                 if self._stopping(should_stop, t_start, time_limit):
                     break
                 k = self._pass_size(spp, target)
-                ppc = self._pixels_per_chunk(k, self.active.size)
                 pixels = self.active
-                futures = {pool.submit(self._trace, pixels[a:a + ppc], k)
-                           for a in range(0, pixels.size, ppc)}
+                futures = {pool.submit(self._trace, pixels[a:b], k)
+                           for a, b in self._chunks(k, pixels.size)}
                 while futures:
                     finished, futures = wait(futures, timeout=0.1, return_when=FIRST_COMPLETED)
                     for f in finished:
@@ -597,11 +597,22 @@ class RenderSession:
             cap = min(cap, self.adaptive.next_check(self.pass_samples) - self.pass_samples)
         return max(1, min(spp, cap, target - self.pass_samples))
 
-    def _pixels_per_chunk(self, spp, npix):
-        paths = spp * npix
-        # At least two chunks per worker for load balance, at most a batch each.
-        per_chunk = min(self.roots_per_chunk, max(MIN_CHUNK_PATHS, -(-paths // (2 * self.threads))))
-        return max(1, min(npix, per_chunk // spp))
+    def _chunks(self, spp, npix):
+        """Pixel ranges [a, b) of a pass of ``spp`` samples over ``npix`` pixels, in the order
+        the workers take them: each at most a batch and at most a quarter of what is left per
+        worker (at least two chunks per worker), at least MIN_CHUNK_PATHS paths.  The chunks
+        shrink towards the pass's end (guided scheduling), so the workers finish it together:
+        a pass ends in a wait for its last chunk, and equal chunks of a batch each left one
+        core idle for up to a chunk's time at every pass."""
+        most = max(1, min(npix, self.roots_per_chunk // spp))
+        least = max(1, min(most, MIN_CHUNK_PATHS // spp))
+        a = 0
+        while a < npix:
+            size = min(most, max(least, -(-(npix - a) // (2 * self.threads))))
+            if npix - a - size < least:
+                size = npix - a          # no chunk smaller than the least after this one
+            yield a, a + size
+            a += size
 
     def _worker(self) -> _Worker:
         w = getattr(self._workers, "w", None)

@@ -17,7 +17,7 @@ import pytest
 
 from mcengine import samplers
 from mcengine.scene import Camera, Film, Geometry, Integrator, Light, Material, SceneDescription, World
-from mcengine.session import RenderSession
+from mcengine.session import MIN_CHUNK_PATHS, RenderSession
 
 from .expect import assert_mean, image_mean_and_se, render
 from .scenes import inside_sphere_scene, translation, uv_sphere
@@ -170,6 +170,26 @@ def test_small_renders_finish_in_one_pass_after_the_first(res, samples, time_lim
     done = []
     RenderSession(scene).run(on_pass=lambda s: done.append(s.samples_done))
     assert done == expected
+
+
+@pytest.mark.parametrize("npix, spp", [(65536, 32), (65536, 1), (100, 64), (3, 1)])
+def test_a_pass_ends_in_small_chunks(npix, spp):
+    """A pass's chunks tile its pixels in order, none above a batch, none but the last below
+    MIN_CHUNK_PATHS paths (unless the pass is smaller), and they shrink towards its end so
+    that the two workers finish it together: the last chunk of a pass of many batches holds
+    at most a tenth of a batch, where equal chunks of a batch each left a core idle for up
+    to a batch's time at the end of every pass."""
+    session = RenderSession(inside_sphere_scene(albedo=0.5, emission=1.0, samples=1, res=8),
+                            threads=2)
+    chunks = list(session._chunks(spp, npix))
+    assert chunks[0][0] == 0 and chunks[-1][1] == npix
+    assert all(a1 == b0 for (_, b0), (a1, _) in zip(chunks, chunks[1:]))
+    paths = [(b - a) * spp for a, b in chunks]
+    assert max(paths) <= max(session.roots_per_chunk, spp)
+    assert min(paths[:-1], default=MIN_CHUNK_PATHS) >= min(MIN_CHUNK_PATHS, npix * spp)
+    if npix * spp >= 8 * session.roots_per_chunk:
+        assert paths[-1] <= session.roots_per_chunk / 10, paths
+        assert paths[:-1] == sorted(paths[:-1], reverse=True), paths
 
 
 def _furnace_sphere(material, samples=8):

@@ -600,7 +600,8 @@ class RenderSession:
     def _chunks(self, spp, npix):
         """Pixel ranges [a, b) of a pass of ``spp`` samples over ``npix`` pixels, in the order
         the workers take them: each at most a batch and at most a quarter of what is left per
-        worker (at least two chunks per worker), at least MIN_CHUNK_PATHS paths.  The chunks
+        worker (at least two chunks per worker), at least MIN_CHUNK_PATHS paths but for a
+        last one that a batch could not take with the one before it.  The chunks
         shrink towards the pass's end (guided scheduling), so the workers finish it together:
         a pass ends in a wait for its last chunk, and equal chunks of a batch each left one
         core idle for up to a chunk's time at every pass."""
@@ -609,8 +610,8 @@ class RenderSession:
         a = 0
         while a < npix:
             size = min(most, max(least, -(-(npix - a) // (2 * self.threads))))
-            if npix - a - size < least:
-                size = npix - a          # no chunk smaller than the least after this one
+            if npix - a - size < least and npix - a <= most:
+                size = npix - a          # no smaller chunk after this one, if a batch holds both
             yield a, a + size
             a += size
 

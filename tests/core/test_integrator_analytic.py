@@ -192,6 +192,22 @@ def test_a_pass_ends_in_small_chunks(npix, spp):
         assert paths[:-1] == sorted(paths[:-1], reverse=True), paths
 
 
+@pytest.mark.parametrize("threads, batch", [(1, 4096), (1, 5000), (2, 5000), (3, 20000)])
+def test_no_chunk_exceeds_a_batch(threads, batch):
+    """Over many pass sizes, with any worker count and batch: the chunks tile the pass and
+    none holds more paths than a worker's buffers (a chunk merged with a small remainder
+    once could)."""
+    session = RenderSession(inside_sphere_scene(albedo=0.5, emission=1.0, samples=1, res=8),
+                            threads=threads, batch_size=batch)
+    for spp in (1, 3, 32):
+        for npix in range(1, 3000, 7):
+            chunks = list(session._chunks(spp, npix))
+            assert chunks[0][0] == 0 and chunks[-1][1] == npix
+            assert all(a1 == b0 for (_, b0), (a1, _) in zip(chunks, chunks[1:]))
+            assert max((b - a) * spp for a, b in chunks) <= max(session.roots_per_chunk, spp), \
+                (spp, npix, chunks)
+
+
 def _furnace_sphere(material, samples=8):
     scene = _sky_sphere_scene(0.0, samples=samples)
     scene.materials = [material]

@@ -181,11 +181,7 @@ def test_a_pass_ends_in_small_chunks(npix, spp):
     to a batch's time at the end of every pass."""
     session = RenderSession(inside_sphere_scene(albedo=0.5, emission=1.0, samples=1, res=8),
                             threads=2)
-    chunks = list(session._chunks(spp, npix))
-    assert chunks[0][0] == 0 and chunks[-1][1] == npix
-    assert all(a1 == b0 for (_, b0), (a1, _) in zip(chunks, chunks[1:]))
-    paths = [(b - a) * spp for a, b in chunks]
-    assert max(paths) <= max(session.roots_per_chunk, spp)
+    paths = _chunk_paths(session, spp, npix)
     assert min(paths[:-1], default=MIN_CHUNK_PATHS) >= min(MIN_CHUNK_PATHS, npix * spp)
     if npix * spp >= 8 * session.roots_per_chunk:
         assert paths[-1] <= session.roots_per_chunk / 10, paths
@@ -201,11 +197,18 @@ def test_no_chunk_exceeds_a_batch(threads, batch):
                             threads=threads, batch_size=batch)
     for spp in (1, 3, 32):
         for npix in range(1, 3000, 7):
-            chunks = list(session._chunks(spp, npix))
-            assert chunks[0][0] == 0 and chunks[-1][1] == npix
-            assert all(a1 == b0 for (_, b0), (a1, _) in zip(chunks, chunks[1:]))
-            assert max((b - a) * spp for a, b in chunks) <= max(session.roots_per_chunk, spp), \
-                (spp, npix, chunks)
+            _chunk_paths(session, spp, npix)
+
+
+def _chunk_paths(session, spp, npix):
+    """The paths of each chunk of a pass, after checking that the chunks tile its pixels in
+    order and that none holds more paths than a worker's buffers."""
+    chunks = list(session._chunks(spp, npix))
+    assert chunks[0][0] == 0 and chunks[-1][1] == npix
+    assert all(a1 == b0 for (_, b0), (a1, _) in zip(chunks, chunks[1:]))
+    paths = [(b - a) * spp for a, b in chunks]
+    assert max(paths) <= max(session.roots_per_chunk, spp), (spp, npix, chunks)
+    return paths
 
 
 def _furnace_sphere(material, samples=8):
